@@ -1,0 +1,37 @@
+# Everything a fresh machine needs, from the project's own files.
+#   make demo   — install, then run the demo (writes demo-output/)
+#   make test   — install, then every check: rustfmt, clippy, cargo test, ruff, mypy, pytest
+PY ?= python3
+PIP = $(PY) -m pip --disable-pip-version-check
+CARGO ?= cargo
+PYTEST_WORKERS ?= 2
+
+.PHONY: install demo test lint rust-test py-test bench clean
+
+install:
+	$(PIP) install --quiet 'maturin>=1.7,<2'
+	$(PIP) install --quiet --no-build-isolation -e '.[dev]'
+
+demo: install
+	roughwalk demo --out-dir demo-output
+
+lint:
+	$(CARGO) fmt --all -- --check
+	$(CARGO) clippy --workspace --all-targets --release -- -D warnings
+	$(PY) -m ruff check python tests benchmarks examples
+	$(PY) -m ruff format --check python tests benchmarks examples
+	$(PY) -m mypy
+
+rust-test:
+	$(CARGO) test --release -p roughwalk-core
+
+py-test:
+	$(PY) -m pytest -n $(PYTEST_WORKERS) -q
+
+test: install lint rust-test py-test
+
+bench: install
+	$(PY) benchmarks/bench_sdf.py
+
+clean:
+	rm -rf target demo-output python/roughwalk/_core*.so

@@ -1,0 +1,11 @@
+//! roughwalk-core: the pure-Rust hot loops of roughwalk.
+//!
+//! Knows no Python. Every public function takes plain slices and returns
+//! plain vectors or [`CoreError`], so that it is tested with `cargo test`
+//! and bound to Python by the thin `roughwalk-py` crate.
+
+pub mod error;
+pub mod heightfield;
+
+pub use error::{CoreError, CoreResult};
+pub use heightfield::{HeightField, Interpolation};

@@ -1,0 +1,16 @@
+//! PyO3 bindings of `roughwalk-core`. Type and error conversion only: every
+//! computation lives in the core crate. One file per core concept, each with
+//! a `register` function called here.
+
+use pyo3::prelude::*;
+
+mod errors;
+mod heightfield;
+
+/// The compiled module `roughwalk._core`.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    heightfield::register(m)?;
+    Ok(())
+}

@@ -1,0 +1,28 @@
+"""roughwalk: footstep, full-body and dynamic trajectories for quadrupeds on rough terrain.
+
+The public API is re-exported here; each wing (:mod:`roughwalk.terrain`, ...)
+has its own ``__init__`` with a fuller API.
+"""
+
+from roughwalk._core import __version__
+from roughwalk.errors import (
+    ConfigError,
+    InvalidArgumentError,
+    PlanningError,
+    RobotModelError,
+    RoughwalkError,
+    TerrainError,
+)
+from roughwalk.terrain import Terrain, load_terrain
+
+__all__ = [
+    "__version__",
+    "RoughwalkError",
+    "InvalidArgumentError",
+    "TerrainError",
+    "RobotModelError",
+    "PlanningError",
+    "ConfigError",
+    "Terrain",
+    "load_terrain",
+]
