@@ -26,3 +26,7 @@ class HeightField:
     def is_known(self, xy: NDArray[np.float64]) -> NDArray[np.bool_]: ...
     @property
     def shape(self) -> tuple[int, int]: ...
+
+# ---- sdf (crates/roughwalk-py/src/sdf.rs) ----
+
+# ---- robot kinematics (crates/roughwalk-py/src/robot.rs) ----

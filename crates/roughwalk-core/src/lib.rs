@@ -6,6 +6,8 @@
 
 pub mod error;
 pub mod heightfield;
+pub mod kinematics;
+pub mod sdf;
 
 pub use error::{CoreError, CoreResult};
 pub use heightfield::{HeightField, Interpolation};

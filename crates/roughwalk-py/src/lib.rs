@@ -6,11 +6,15 @@ use pyo3::prelude::*;
 
 mod errors;
 mod heightfield;
+mod robot;
+mod sdf;
 
 /// The compiled module `roughwalk._core`.
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     heightfield::register(m)?;
+    sdf::register(m)?;
+    robot::register(m)?;
     Ok(())
 }

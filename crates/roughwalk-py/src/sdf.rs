@@ -1,0 +1,7 @@
+//! Bindings for the core's sdf module. Being written.
+
+use pyo3::prelude::*;
+
+pub fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
+    Ok(())
+}
