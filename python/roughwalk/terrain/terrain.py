@@ -54,23 +54,30 @@ class MujocoHeightField:
 
 
 def _fill_unknown(raw: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Fill each connected unknown region with the highest known height on its border."""
+    """Fill each connected unknown region with the highest known height on its border.
+
+    A region's border is every known cell touching it, diagonals included.
+    """
     unknown = ~np.isfinite(raw)
     if not unknown.any():
         return raw.copy()
-    filled = raw.copy()
     labels, n = ndimage.label(unknown)
-    border = ndimage.binary_dilation(unknown) & ~unknown
-    border_labels = ndimage.grey_dilation(labels, size=(3, 3))
-    # For every border cell, the label of an adjacent unknown region; take per-label max height.
-    lab = border_labels[border]
-    hts = raw[border]
+    nx, ny = raw.shape
+    padded = np.pad(raw, 1, constant_values=np.nan)
     top = np.full(n + 1, -np.inf)
-    np.maximum.at(top, lab, hts)
-    # Regions whose border touches another region only through grey_dilation's max label:
-    # fall back to the global maximum (conservative).
-    gmax = float(np.nanmax(raw))
-    top[~np.isfinite(top)] = gmax
+    # A known cell may border several regions, so every neighbour direction
+    # feeds every region it touches.
+    for di in (-1, 0, 1):
+        for dj in (-1, 0, 1):
+            if di == 0 and dj == 0:
+                continue
+            neighbour = padded[1 + di : 1 + di + nx, 1 + dj : 1 + dj + ny]
+            sel = unknown & np.isfinite(neighbour)
+            np.maximum.at(top, labels[sel], neighbour[sel])
+    # Every region touches a known cell (an all-unknown grid is refused); keep a
+    # conservative fallback all the same.
+    top[~np.isfinite(top)] = float(np.nanmax(raw))
+    filled = raw.copy()
     filled[unknown] = top[labels[unknown]]
     return filled
 
@@ -93,6 +100,7 @@ class Terrain:
     mesh:
         For meshes that are not 2.5-D: the original triangle mesh, used by the
         SDF instead of the height field (the heights are its upper envelope).
+
     """
 
     def __init__(
@@ -134,9 +142,7 @@ class Terrain:
         self.name = name
         self.spec = spec if spec is not None else name
         self.mesh = mesh
-        self._hf = _core.HeightField(
-            self.x0, self.y0, self.dx, self.dy, self._heights, self._known
-        )
+        self._hf = _core.HeightField(self.x0, self.y0, self.dx, self.dy, self._heights, self._known)
 
     # ----------------------------------------------------------------- grid
     @property
@@ -162,12 +168,12 @@ class Terrain:
     @property
     def x(self) -> NDArray[np.float64]:
         """Grid x coordinates [m], shape (nx,)."""
-        return self.x0 + self.dx * np.arange(self.shape[0])
+        return np.arange(self.shape[0], dtype=np.float64) * self.dx + self.x0
 
     @property
     def y(self) -> NDArray[np.float64]:
         """Grid y coordinates [m], shape (ny,)."""
-        return self.y0 + self.dy * np.arange(self.shape[1])
+        return np.arange(self.shape[1], dtype=np.float64) * self.dy + self.y0
 
     @property
     def extent(self) -> tuple[float, float, float, float]:
@@ -200,7 +206,9 @@ class Terrain:
             raise InvalidArgumentError(f"expected xy of shape (N, 2), got {a.shape}")
         return np.ascontiguousarray(a)
 
-    def height(self, xy: ArrayLike, interpolation: Interpolation = "bilinear") -> NDArray[np.float64]:
+    def height(
+        self, xy: ArrayLike, interpolation: Interpolation = "bilinear"
+    ) -> NDArray[np.float64]:
         """Heights [m] at the (N, 2) points ``xy`` [m]."""
         return self._hf.height(self._xy(xy), interpolation)
 
@@ -210,19 +218,23 @@ class Terrain:
         """Heights [m] (N,) and gradients (∂z/∂x, ∂z/∂y) (N, 2) at ``xy`` [m]."""
         return self._hf.height_and_gradient(self._xy(xy), interpolation)
 
-    def normal(self, xy: ArrayLike, interpolation: Interpolation = "bilinear") -> NDArray[np.float64]:
-        """Unit upward surface normals (N, 3) at ``xy`` [m]."""
+    def normal(
+        self, xy: ArrayLike, interpolation: Interpolation = "bilinear"
+    ) -> NDArray[np.float64]:
+        """Return unit upward surface normals (N, 3) at ``xy`` [m]."""
         _, g = self.height_and_gradient(xy, interpolation)
         n = np.column_stack([-g[:, 0], -g[:, 1], np.ones(len(g))])
         return n / np.linalg.norm(n, axis=1, keepdims=True)
 
-    def slope(self, xy: ArrayLike, interpolation: Interpolation = "bilinear") -> NDArray[np.float64]:
+    def slope(
+        self, xy: ArrayLike, interpolation: Interpolation = "bilinear"
+    ) -> NDArray[np.float64]:
         """Surface inclination from horizontal [rad] at ``xy`` [m]."""
         _, g = self.height_and_gradient(xy, interpolation)
         return np.arctan(np.hypot(g[:, 0], g[:, 1]))
 
     def is_known(self, xy: ArrayLike) -> NDArray[np.bool_]:
-        """True where every grid corner of the cell under ``xy`` was measured."""
+        """Return True where every grid corner of the cell under ``xy`` was measured."""
         return self._hf.is_known(self._xy(xy))
 
     # ----------------------------------------------------- derived products
@@ -239,7 +251,11 @@ class Terrain:
         return compute_features(self, **options)
 
     def to_mesh(self) -> trimesh.Trimesh:
-        """The height field as a triangle mesh (two triangles per grid cell, top surface only)."""
+        """Return the height field as a triangle mesh [m].
+
+        One vertex per grid point at its (filled) height, two upward-facing
+        triangles per cell, top surface only (an open sheet, no walls or base).
+        """
         import trimesh
 
         nx, ny = self.shape
@@ -267,7 +283,7 @@ class Terrain:
         return MujocoHeightField(np.ascontiguousarray(elevation), size, center)
 
     def info(self) -> dict[str, Any]:
-        """A JSON-ready summary of the terrain."""
+        """Return a JSON-ready summary of the terrain."""
         x_min, x_max, y_min, y_max = self.extent
         lo, hi = self.height_range
         return {

@@ -1,0 +1,40 @@
+"""Fixtures shared by the Python tests: the ../shared data beside the checkout."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from functools import cache
+from pathlib import Path
+
+import pytest
+
+from roughwalk.terrain import Terrain
+
+SHARED_DIR = Path(__file__).resolve().parents[2].parent / "shared"
+LITTLEDOG_BOARDS = ("terrainA", "terrainAC", "terrainAD", "terrainAE", "terrainC", "terrainY")
+
+
+@pytest.fixture(scope="session")
+def shared_dir() -> Path:
+    """The shared data directory (read only; never copy from it into the project)."""
+    if not SHARED_DIR.is_dir():
+        pytest.skip(f"shared data not found at {SHARED_DIR}")
+    return SHARED_DIR
+
+
+@cache
+def _load_board(path: Path) -> Terrain:
+    from roughwalk.terrain.loaders import load_file
+
+    return load_file(path)
+
+
+@pytest.fixture(scope="session")
+def littledog_board(shared_dir: Path) -> Callable[[str], Terrain]:
+    """Load a LittleDog board by name ("terrainA", "A", ...), cached for the session."""
+
+    def load(name: str) -> Terrain:
+        stem = name if name.startswith("terrain") else f"terrain{name}"
+        return _load_board(shared_dir / "terrains" / "littledog" / f"{stem}.mat")
+
+    return load
