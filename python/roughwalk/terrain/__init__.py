@@ -3,6 +3,8 @@
 This wing knows no robot. Start with :func:`load_terrain`.
 """
 
+from roughwalk.terrain.features import TerrainFeatures, compute_features, orient_features
+from roughwalk.terrain.generators import generate, list_generators
 from roughwalk.terrain.spec import TerrainPart, load_terrain, parse_spec
 from roughwalk.terrain.terrain import MujocoHeightField, Terrain
 
@@ -12,4 +14,9 @@ __all__ = [
     "TerrainPart",
     "load_terrain",
     "parse_spec",
+    "generate",
+    "list_generators",
+    "TerrainFeatures",
+    "compute_features",
+    "orient_features",
 ]
