@@ -276,6 +276,10 @@ def bad_inputs(tmp_path: Path) -> list[tuple[Path, dict, str]]:
         ),
         (write_mat(tmp_path, "matrix.mat", x=np.zeros((2, 5)), y=y, Z=z), {}, "vector"),
     ]
+    cases += [
+        (write_mat(tmp_path, "complex.mat", x=x, y=y, Z=z + 1j), {}, "real numeric"),
+        (write_mat(tmp_path, "text.mat", x="abcde", y=y, Z=z), {}, "real numeric"),
+    ]
     (tmp_path / "garbage.mat").write_bytes(b"not a mat file at all")
     cases.append((tmp_path / "garbage.mat", {}, "cannot read"))
     Image.fromarray(np.zeros((4, 4), np.uint8)).save(tmp_path / "m.png")
@@ -286,6 +290,8 @@ def bad_inputs(tmp_path: Path) -> list[tuple[Path, dict, str]]:
         (tmp_path / "m.png", {"origin": (0.0, float("nan"))}, "origin"),
         (tmp_path / "m.png", {"colour": "red"}, "unknown loader option"),
     ]
+    Image.fromarray(np.zeros((3, 4, 4), np.uint8), mode="RGBA").save(tmp_path / "clear.png")
+    cases.append((tmp_path / "clear.png", {}, "every cell is unknown"))
     Image.fromarray(np.zeros((1, 4), np.uint8)).save(tmp_path / "thin.png")
     cases.append((tmp_path / "thin.png", {}, "2×2"))
     (tmp_path / "empty.stl").write_bytes(b"")

@@ -65,10 +65,7 @@ def load_mat(path: str | Path, *, name: str | None = None) -> Terrain:
         )
     x = _vector(data["x"], "x", p)
     y = _vector(data["y"], "y", p)
-    try:
-        z = np.asarray(data["Z"], dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TerrainError(f"{p}: 'Z' is not a numeric array") from None
+    z = _real(data["Z"], "Z", p)
     if z.shape != (y.size, x.size):
         raise TerrainError(
             f"{p}: 'Z' has shape {z.shape} but x has {x.size} and y has {y.size} values; "
@@ -86,10 +83,17 @@ def load_mat(path: str | Path, *, name: str | None = None) -> Terrain:
 
 def _vector(a: object, label: str, path: Path) -> np.ndarray:
     """Read a MATLAB row or column vector as a 1-D float array."""
-    try:
-        v = np.asarray(a, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TerrainError(f"{path}: '{label}' is not numeric") from None
+    v = _real(a, label, path)
     if v.ndim > 2 or (v.ndim == 2 and min(v.shape) != 1):
         raise TerrainError(f"{path}: '{label}' must be a 1×n or n×1 vector, got shape {v.shape}")
     return v.ravel()
+
+
+def _real(a: object, label: str, path: Path) -> np.ndarray:
+    """Read a MATLAB numeric array as floats, refusing text, cells, structs and complex."""
+    arr = np.asarray(a)
+    if arr.dtype.kind not in "biuf":
+        raise TerrainError(
+            f"{path}: '{label}' must be a real numeric array, got MATLAB data of dtype {arr.dtype}"
+        )
+    return arr.astype(np.float64)
