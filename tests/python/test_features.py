@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from roughwalk.errors import InvalidArgumentError, TerrainError
 from roughwalk.terrain import Terrain, compute_features, generate, orient_features
@@ -116,6 +118,36 @@ def test_paraboloid_coefficients():
         np.testing.assert_allclose(v[:, 6], lam[1], atol=1e-6)
         np.testing.assert_allclose(v[:, 7], np.hypot(kx, ky), atol=1e-6)
         assert np.all(v[:, 8] < 1e-6)
+
+
+coefficient = st.floats(-5.0, 5.0, allow_nan=False)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    st.tuples(*[coefficient] * 5),
+    st.floats(-np.pi, np.pi),
+    st.sampled_from([(0, 0), (5, -3), (-7, 6)]),
+)
+def test_any_quadratic_is_recovered_in_any_heading(coeffs, psi, cell):
+    # Zucker's oriented features of z = uᵀKu + kᵀu at a cell c: K' = RᵀKR and
+    # k' = Rᵀ(2Kc + k), with zero residual.
+    a, b, c, d, e = coeffs
+    t = grid_terrain(lambda x, y: a * x * x + 2 * b * x * y + c * y * y + d * x + e * y)
+    f = compute_features(t, radii=(0.012, 0.02), oriented_heading=psi)
+    i, j = I0 + cell[0], J0 + cell[1]
+    centre = np.array([t.x[i], t.y[j]])
+    big_k = np.array([[a, b], [b, c]])
+    r = rotation(psi)
+    kp = r.T @ big_k @ r
+    gp = r.T @ (2 * big_k @ centre + np.array([d, e]))
+    expected = [kp[0, 0], kp[0, 1], kp[1, 1], gp[0], gp[1]]
+    for n in range(2):
+        assert f.valid_by_radius[n, i, j]
+        got = block(f, n)[i, j]
+        np.testing.assert_allclose(got[:5], expected, atol=1e-6)
+        np.testing.assert_allclose(got[5:7], np.linalg.eigvalsh(big_k), atol=1e-6)
+        assert got[8] < 1e-6
 
 
 def test_tilted_plane_has_only_slope_features():
@@ -275,3 +307,18 @@ def test_bad_radii(radii, match):
     t = Terrain(np.zeros((20, 20)), 0.0, 0.0, 0.005, 0.005)
     with pytest.raises(TerrainError, match=match):
         compute_features(t, radii=radii)
+
+
+def test_real_board_against_brute_force(littledog_board):
+    # A LittleDog board at 1.2 mm: the 6 cm disc is a 101 × 101 kernel.
+    t = littledog_board("AE")
+    f = compute_features(t, radii=(0.01, 0.06))
+    rng = np.random.default_rng(0)
+    cells = np.argwhere(f.valid)[rng.choice(int(f.valid.sum()), 4, replace=False)]
+    for n, r in enumerate(f.radii):
+        for i, j in cells:
+            beta, rms = brute_force_fit(t, i, j, r)
+            got = block(f, n)[i, j]
+            scale = np.abs(beta[:5]).max()
+            np.testing.assert_allclose(got[:5], beta[:5], atol=1e-8 * scale)
+            assert got[8] == pytest.approx(rms, rel=1e-6)

@@ -232,6 +232,9 @@ def test_unknown_parameter_lists_the_valid_ones():
     [
         ("large_rocks", {"seed": "3.5"}, "seed"),
         ("large_rocks", {"seed": 3.5}, "seed"),
+        ("large_rocks", {"seed": -1}, "seed"),
+        ("flat", {"resolution": 1e-5}, "resolution"),
+        ("towr_block", {"resolution": 1e-4}, "resolution"),
         ("large_rocks", {"max_height": "nan"}, "max_height"),
         ("large_rocks", {"max_height": math.nan}, "max_height"),
         ("large_rocks", {"max_height": "tall"}, "max_height"),

@@ -16,7 +16,8 @@ Per cell and radius the feature vector is, in this order
 
     k_xx, k_xy, k_yy [1/m], k_x, k_y [-], λ_min(K), λ_max(K) [1/m], |k| [-], residual [m]
 
-where ``residual`` is the RMS of the fit's residuals over the disc.
+where ``residual`` is the RMS of the fit's residuals over the disc. k_z is
+fitted (it absorbs the centre cell's own deviation) but is not a feature.
 :attr:`TerrainFeatures.names` spells them out per radius (``r0.02/k_xx``).
 
 How it is computed: with φ(u) = (u_x², 2u_x u_y, u_y², u_x, u_y, 1), the
@@ -119,25 +120,23 @@ class _Disc:
 
 
 class _Correlator:
-    """Correlations of one height field with many small kernels, by FFT."""
+    """Correlations of one field (or its square) with many small kernels, by FFT."""
 
     def __init__(self, field: NDArray[np.float64], pad: tuple[int, int]) -> None:
         self.shape = field.shape
         self.pad = pad
-        padded = np.pad(field, ((pad[0], pad[0]), (pad[1], pad[1])), mode="edge")
-        self.size = tuple(scipy.fft.next_fast_len(n, real=True) for n in padded.shape)
-        self._spectra: dict[str, NDArray[np.complex128]] = {}
-        self.padded = padded
+        self.padded = np.pad(field, ((pad[0], pad[0]), (pad[1], pad[1])), mode="edge")
+        self.size = tuple(scipy.fft.next_fast_len(n, real=True) for n in self.padded.shape)
+        self._spectra: dict[int, NDArray[np.complex128]] = {}
 
-    def spectrum(self, key: str, values: NDArray[np.float64]) -> NDArray[np.complex128]:
-        if key not in self._spectra:
-            self._spectra[key] = scipy.fft.rfft2(values, s=self.size)
-        return self._spectra[key]
+    def _spectrum(self, power: int) -> NDArray[np.complex128]:
+        if power not in self._spectra:
+            self._spectra[power] = scipy.fft.rfft2(self.padded**power, s=self.size)
+        return self._spectra[power]
 
-    def correlate(
-        self, spectrum: NDArray[np.complex128], kernel: NDArray[np.float64]
-    ) -> NDArray[np.float64]:
-        """Σ_{p,q} kernel[p, q] · field[i + p, j + q] at every cell (i, j), edge-padded."""
+    def correlate(self, kernel: NDArray[np.float64], power: int = 1) -> NDArray[np.float64]:
+        """Σ_{p,q} kernel[p, q] · field[i + p, j + q]^power at every cell (i, j), edge-padded."""
+        spectrum = self._spectrum(power)
         p, q = kernel.shape[0] // 2, kernel.shape[1] // 2
         embedded = np.zeros(self.size)
         # Flipped and wrapped, so that a convolution computes the correlation.
@@ -149,17 +148,11 @@ class _Correlator:
         return full[i0 : i0 + self.shape[0], j0 : j0 + self.shape[1]]
 
 
-def _snap(values: NDArray[np.float64], floor: float) -> NDArray[np.float64]:
-    values[np.abs(values) <= floor] = 0.0
-    return values
-
-
 def _fit_radius(
     disc: _Disc, corr: _Correlator, z: NDArray[np.float64], z_max: float
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Scaled coefficients β̃ (6, nx, ny) and residual energy Σ r² [m²] for one radius."""
-    zf = corr.spectrum("z", corr.padded)
-    sums = np.stack([corr.correlate(zf, k) for k in disc.kernels])
+    sums = np.stack([corr.correlate(k) for k in disc.kernels])
     kernel_sums = disc.kernels.reshape(6, -1).sum(axis=1)
     b = sums - z[None] * kernel_sums[:, None, None]
     beta = np.einsum("ij,jxy->ixy", disc.a_inv, b)
@@ -167,9 +160,8 @@ def _fit_radius(
     b_floor = _FFT_RELATIVE_NOISE * z_max * np.abs(disc.kernels).reshape(6, -1).sum(axis=1)
     beta_floor = np.abs(disc.a_inv) @ b_floor
     for i in range(6):
-        _snap(beta[i], beta_floor[i])
-    z2f = corr.spectrum("z2", corr.padded**2)
-    sum_sq = corr.correlate(z2f, disc.kernels[5])
+        beta[i][np.abs(beta[i]) <= beta_floor[i]] = 0.0
+    sum_sq = corr.correlate(disc.kernels[5], power=2)
     # Σ (z − z_c)² = Σ z² − 2 z_c Σ z + n z_c²; the fit explains βᵀb of it.
     energy = sum_sq - 2 * z * sums[5] + disc.count * z**2 - np.einsum("ixy,ixy->xy", beta, b)
     energy_floor = 8 * _FFT_RELATIVE_NOISE * disc.count * z_max**2
@@ -437,8 +429,7 @@ def compute_features(
         ok = np.zeros((nx, ny), dtype=bool)
         ok[p : nx - p, q : ny - q] = True
         if unknown is not None:
-            spec = unknown.spectrum("u", unknown.padded)
-            touched = unknown.correlate(spec, (disc.kernels[5] > 0).astype(np.float64)) > 0.5
+            touched = unknown.correlate(disc.kernels[5]) > 0.5
             ok &= ~touched
         valid[n] = ok
     if oriented_heading is not None:

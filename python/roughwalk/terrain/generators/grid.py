@@ -26,6 +26,9 @@ from roughwalk.terrain.terrain import Terrain
 
 __all__ = ["CourseParams", "RandomCourseParams", "FieldParams", "Grid", "in_box"]
 
+# More grid points than this is a mistaken resolution, not a terrain (≈ 400 MB of heights).
+MAX_GRID_POINTS = 50_000_000
+
 # Grid points within this distance [m] of a box edge count as inside, so that
 # a box from 1.0 to 2.2 m includes the points printed as 1.0 and 2.2.
 EDGE_TOLERANCE = 1e-9
@@ -61,16 +64,6 @@ class Grid:
         """Grid y coordinates [m], shape (ny,)."""
         return self.y0 + self.dy * np.arange(self.ny, dtype=np.float64)
 
-    @property
-    def X(self) -> NDArray[np.float64]:  # noqa: N802 — mesh names follow numpy's meshgrid habit
-        """(nx, ny) x coordinate of every grid point [m]."""
-        return np.broadcast_to(self.x[:, None], (self.nx, self.ny))
-
-    @property
-    def Y(self) -> NDArray[np.float64]:  # noqa: N802
-        """(nx, ny) y coordinate of every grid point [m]."""
-        return np.broadcast_to(self.y[None, :], (self.nx, self.ny))
-
     def zeros(self) -> NDArray[np.float64]:
         """Return a (nx, ny) array of zero heights [m]."""
         return np.zeros((self.nx, self.ny))
@@ -78,6 +71,15 @@ class Grid:
     def terrain(self, heights: NDArray[np.float64]) -> Terrain:
         """Wrap ``heights`` [m] on this grid as a :class:`Terrain` (the registry names it)."""
         return Terrain(heights, self.x0, self.y0, self.dx, self.dy)
+
+
+def _check_size(length: float, width: float, resolution: float) -> None:
+    points = (length / resolution + 1) * (width / resolution + 1)
+    if points > MAX_GRID_POINTS:
+        raise TerrainError(
+            f"parameter 'resolution' ({resolution} m) gives {points:.3g} grid points over "
+            f"{length} m × {width} m; at most {MAX_GRID_POINTS:.0e} are allowed"
+        )
 
 
 def in_box(
@@ -112,6 +114,7 @@ class CourseParams(GeneratorParams):
                 f"parameter 'resolution' ({self.resolution} m) must be at most half of "
                 f"'length' and 'width' ({self.length} m, {self.width} m)"
             )
+        _check_size(self.length, self.width, self.resolution)
 
     @property
     def feature_start(self) -> float:
@@ -135,7 +138,9 @@ class CourseParams(GeneratorParams):
 
 @dataclass(frozen=True)
 class _Seeded(GeneratorParams):
-    seed: int = param(0, "", "random seed (numpy default_rng); same seed, same terrain")
+    seed: int = param(
+        0, "", "random seed (numpy default_rng); same seed, same terrain", "nonnegative"
+    )
     max_height: float = param(0.108, "m", "tallest feature above the pads", "positive")
 
 
@@ -172,6 +177,7 @@ class FieldParams(GeneratorParams):
                     f"parameters '{a}' < '{b}' must span at least two cells of 'resolution' "
                     f"({self.resolution} m), got {lo} .. {hi} m"
                 )
+        _check_size(self.x_max - self.x_min, self.y_max - self.y_min, self.resolution)
 
     def grid(self) -> Grid:
         """Return the field grid."""
