@@ -88,7 +88,6 @@ def test_normals_and_slope_on_a_tilted_plane(interpolation: str) -> None:
     a, b = 0.3, -0.45
     t = tilted_plane(a, b, 0.1)
     rng = np.random.default_rng(5)
-    # Away from the edge cells (see the xfail below).
     xy = np.column_stack([rng.uniform(-0.4, 0.4, 40), rng.uniform(0.25, 0.5, 40)])
     np.testing.assert_allclose(t.height(xy, interpolation), a * xy[:, 0] + b * xy[:, 1] + 0.1)
     n = t.normal(xy, interpolation)
@@ -98,11 +97,6 @@ def test_normals_and_slope_on_a_tilted_plane(interpolation: str) -> None:
     np.testing.assert_allclose(t.slope(xy, interpolation), np.arctan(np.hypot(a, b)), atol=1e-12)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the core's Catmull–Rom bicubic clamps the samples beyond the grid edge, so it "
-    "does not reproduce a plane in the outermost cells (linear extrapolation would)",
-)
 def test_bicubic_reproduces_a_plane_in_the_edge_cells() -> None:
     t = tilted_plane(0.3, -0.45, 0.1)
     xy = np.array([[-0.47, 0.3], [0.46, 0.4], [0.0, 0.21], [0.1, 0.54]])

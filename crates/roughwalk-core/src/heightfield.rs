@@ -107,6 +107,26 @@ impl HeightField {
         self.heights[ix * self.ny + iy]
     }
 
+    /// Height [m] at grid index (ix, iy), extrapolated linearly one cell past
+    /// the edge so that bicubic interpolation reproduces planes in edge cells.
+    #[inline]
+    fn at_extrapolated(&self, ix: isize, iy: isize) -> f64 {
+        let (nx, ny) = (self.nx as isize, self.ny as isize);
+        if ix < 0 {
+            return 2.0 * self.at_extrapolated(0, iy) - self.at_extrapolated(1, iy);
+        }
+        if ix >= nx {
+            return 2.0 * self.at_extrapolated(nx - 1, iy) - self.at_extrapolated(nx - 2, iy);
+        }
+        if iy < 0 {
+            return 2.0 * self.at(ix, 0) - self.at(ix, 1);
+        }
+        if iy >= ny {
+            return 2.0 * self.at(ix, ny - 1) - self.at(ix, ny - 2);
+        }
+        self.at(ix, iy)
+    }
+
     /// Whether grid point (ix, iy) was measured (false outside the grid).
     #[inline]
     pub fn is_known_index(&self, ix: isize, iy: isize) -> bool {
@@ -193,7 +213,7 @@ impl HeightField {
                 let mut gy = 0.0;
                 for (a, (wxa, dwxa)) in wx.iter().zip(dwx.iter()).enumerate() {
                     for (b, (wyb, dwyb)) in wy.iter().zip(dwy.iter()).enumerate() {
-                        let z = self.at(ix + a as isize - 1, iy + b as isize - 1);
+                        let z = self.at_extrapolated(ix + a as isize - 1, iy + b as isize - 1);
                         h += wxa * wyb * z;
                         gx += dwxa * wyb * z;
                         gy += wxa * dwyb * z;
