@@ -43,6 +43,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     except RoughwalkError as e:
         print(f"roughwalk: error: {e}", file=sys.stderr)
         return 1
+    except BrokenPipeError:
+        # Output piped into `head` and the like: stop quietly, as Unix tools do.
+        import os
+
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 0
     except KeyboardInterrupt:
         print("roughwalk: interrupted", file=sys.stderr)
         return 130
