@@ -13,6 +13,7 @@ from roughwalk.errors import (
     RoughwalkError,
     TerrainError,
 )
+from roughwalk.robots import Robot, load_robot
 from roughwalk.terrain import Terrain, load_terrain
 
 __all__ = [
@@ -25,4 +26,6 @@ __all__ = [
     "ConfigError",
     "Terrain",
     "load_terrain",
+    "Robot",
+    "load_robot",
 ]
