@@ -1,8 +1,8 @@
 """Robots: quadruped models from MJCF, their kinematic description and kinematics.
 
 Start with :func:`load_robot` (a registered name or any MJCF path); the
-shipped models are listed by :func:`list_robots`. This wing knows terrain
-nothing of planning or simulation; it uses MuJoCo only to compile model files.
+shipped models are listed by :func:`list_robots`. This wing knows nothing of
+planning or simulation; it uses MuJoCo only to compile model files.
 """
 
 from roughwalk.robots.canonical_frame import LEG_NAMES, leg_label

@@ -91,6 +91,7 @@ class Robot:
         self._model = model
         self._d: QuadrupedDescription = describe_quadruped(model)
         self._core_quadruped: Any = None
+        self._core_error: RobotModelError | None = None
         free = [
             j
             for j in range(model.njnt)
@@ -274,26 +275,42 @@ class Robot:
     # ---- kinematics ---------------------------------------------------------------
 
     def _quadruped(self) -> Any:
-        """Return the Rust ``Quadruped`` of this robot, or None while the binding is missing."""
-        leg_chain = getattr(_core, "LegChain", None)
-        quadruped = getattr(_core, "Quadruped", None)
-        if self._core_quadruped is None and leg_chain is not None and quadruped is not None:
-            chains = [
-                leg_chain(
-                    leg.body_pos,
-                    leg.body_quat,
-                    leg.anchor,
-                    leg.axis,
-                    leg.lower,
-                    leg.upper,
-                    leg.velocity_limit,
-                    leg.foot,
-                    leg.foot_radius,
-                    leg.knee_sign,
+        """Return the Rust ``Quadruped`` of this robot, or None when it cannot be built.
+
+        It cannot be built when the compiled core predates the kinematics
+        binding, or when a leg's joint axes do not have the abduction–flexion–knee
+        structure the analytic IK needs; forward kinematics then runs in numpy
+        and :meth:`inverse_kinematics` reports why it is unavailable.
+        """
+        if self._core_quadruped is None and self._core_error is None:
+            leg_chain = getattr(_core, "LegChain", None)
+            quadruped = getattr(_core, "Quadruped", None)
+            if leg_chain is None or quadruped is None:
+                self._core_error = RobotModelError(
+                    "inverse kinematics needs the Rust core's Quadruped, which this build of "
+                    "roughwalk._core lacks; rebuild it with `make install`"
                 )
-                for leg in self._d.legs
-            ]
-            self._core_quadruped = quadruped(chains)
+                return None
+            try:
+                chains = [
+                    leg_chain(
+                        leg.body_pos,
+                        leg.body_quat,
+                        leg.anchor,
+                        leg.axis,
+                        leg.lower,
+                        leg.upper,
+                        leg.velocity_limit,
+                        leg.foot,
+                        leg.foot_radius,
+                        leg.knee_sign,
+                        name=f"{self.name} {name}",
+                    )
+                    for name, leg in zip(LEG_NAMES, self._d.legs, strict=True)
+                ]
+                self._core_quadruped = quadruped(chains)
+            except RobotModelError as e:
+                self._core_error = e
         return self._core_quadruped
 
     def foot_positions(
@@ -332,10 +349,7 @@ class Robot:
         quat = _unit_quat(base_quat)
         core = self._quadruped()
         if core is None:
-            raise RobotModelError(
-                "inverse kinematics needs the Rust core's Quadruped, which this build of "
-                "roughwalk._core lacks; rebuild with `make install`"
-            )
+            raise RobotModelError(f"robot '{self.name}': {self._core_error}")
         qc, reachable = core.inverse_kinematics(targets, pos, quat)
         return self.from_canonical(np.asarray(qc)), np.asarray(reachable, dtype=bool)
 
