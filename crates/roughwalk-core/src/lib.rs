@@ -4,10 +4,12 @@
 //! plain vectors or [`CoreError`], so that it is tested with `cargo test`
 //! and bound to Python by the thin `roughwalk-py` crate.
 
+pub mod dubins;
 pub mod error;
 pub mod heightfield;
 pub mod kinematics;
 pub mod sdf;
+pub mod search;
 
 pub use error::{CoreError, CoreResult};
 pub use heightfield::{HeightField, Interpolation};
