@@ -1,7 +1,7 @@
 """Type stubs for the compiled module ``roughwalk._core`` (the Rust core's bindings)."""
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 __version__: str
 
@@ -30,3 +30,167 @@ class HeightField:
 # ---- sdf (crates/roughwalk-py/src/sdf.rs) ----
 
 # ---- robot kinematics (crates/roughwalk-py/src/robot.rs) ----
+
+class LegChain:
+    """One leg: hinges HAA, HFE, KFE from the trunk (base) frame to a spherical foot.
+
+    Body k's pose follows MuJoCo's hinge: T_k = T_{k-1} · [R(body_quat_k), body_pos_k] ·
+    Trans(anchor_k) · Rot(axis_k, q_k) · Trans(-anchor_k); the foot centre is T_3 · foot.
+    ``knee_sign`` (+1/-1) picks the IK knee branch: the sign of the angle, right-handed
+    about the HFE axis, from the HFE→KFE segment to the KFE→foot segment (projected on
+    the plane ⟂ that axis); for a leg straight at q_KFE = 0 with KFE and HFE axes
+    pointing the same way, the sign of q_KFE. Raises ``RobotModelError`` when HFE ∦ KFE
+    or HFE ∦⟂ HAA (the analytic IK's assumption).
+    """
+
+    def __init__(
+        self,
+        body_pos: ArrayLike,
+        body_quat: ArrayLike,
+        anchor: ArrayLike,
+        axis: ArrayLike,
+        lower: ArrayLike,
+        upper: ArrayLike,
+        velocity_limit: ArrayLike,
+        foot: ArrayLike,
+        foot_radius: float,
+        knee_sign: float,
+        name: str = "leg",
+    ) -> None: ...
+    def fk(self, q: ArrayLike) -> NDArray[np.float64]:
+        """Foot centre in the base frame, FK_B(q) [m], shape (3,)."""
+    def jacobian(self, q: ArrayLike) -> NDArray[np.float64]:
+        """∂FK_B/∂q [m/rad], shape (3, 3), column k for joint k."""
+    def point_jacobian(
+        self, q: ArrayLike, link: int, point: ArrayLike
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Position (3,) [m] and ∂p/∂q (3, 3) of a point fixed on link 0/1/2 (hip/thigh/shank)."""
+    def link_frames(self, q: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Origins (3, 3) [m] and rotation matrices (3, 3, 3) of the joint bodies, base frame."""
+    def ik(
+        self, target: ArrayLike, knee_sign: float | None = None
+    ) -> tuple[NDArray[np.float64], bool, bool, float]:
+        """IK_B: ``(q, reachable, within_limits, error)`` for a base-frame target [m].
+
+        ``q`` is always within limits; out of reach it is the closest reachable foot
+        (Zucker 2011, §3.1). ``within_limits`` is False when a joint limit is what keeps
+        the foot off the target; ``error`` is the foot-to-target distance [m].
+        """
+    @property
+    def name(self) -> str: ...
+    @property
+    def body_pos(self) -> NDArray[np.float64]: ...
+    @property
+    def body_quat(self) -> NDArray[np.float64]: ...
+    @property
+    def anchor(self) -> NDArray[np.float64]: ...
+    @property
+    def axis(self) -> NDArray[np.float64]: ...
+    @property
+    def lower(self) -> NDArray[np.float64]: ...
+    @property
+    def upper(self) -> NDArray[np.float64]: ...
+    @property
+    def velocity_limit(self) -> NDArray[np.float64]: ...
+    @property
+    def foot(self) -> NDArray[np.float64]: ...
+    @property
+    def foot_radius(self) -> float: ...
+    @property
+    def knee_sign(self) -> float: ...
+
+class BodyPoseStep:
+    """One body-pose step: the new trunk pose and the applied (Δx, ω), world frame."""
+
+    @property
+    def base_pos(self) -> NDArray[np.float64]: ...
+    @property
+    def base_quat(self) -> NDArray[np.float64]: ...
+    @property
+    def delta_x(self) -> NDArray[np.float64]: ...
+    @property
+    def omega(self) -> NDArray[np.float64]: ...
+    @property
+    def value_before(self) -> float:
+        """Σ|e_i| (reachability), signed distance d (obstacle) or CoM margin (support) [m]."""
+    @property
+    def q(self) -> NDArray[np.float64] | None:
+        """Reachability step only: the 12 IK joint angles [rad] at the old pose."""
+    @property
+    def reachable(self) -> NDArray[np.bool_] | None:
+        """Reachability step only: which feet the IK reached at the old pose."""
+
+class Quadruped:
+    """Four legs in canonical order LF, RF, LH, RH; q is leg-major (HAA, HFE, KFE) × 4."""
+
+    def __init__(self, legs: list[LegChain]) -> None: ...
+    @property
+    def legs(self) -> list[LegChain]: ...
+    def foot_positions(
+        self, q: ArrayLike, base_pos: ArrayLike | None = None, base_quat: ArrayLike | None = None
+    ) -> NDArray[np.float64]:
+        """World feet (4, 3) [m]: R·FK_B(q_i) + x; identity pose by default."""
+    def inverse_kinematics(
+        self, feet: ArrayLike, base_pos: ArrayLike | None = None, base_quat: ArrayLike | None = None
+    ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """IK_W of world feet (4, 3) [m]: q (12,) [rad] and reached flags (4,)."""
+    def fk_batch(self, q: ArrayLike) -> NDArray[np.float64]:
+        """Base-frame feet (N, 4, 3) [m] of joint angles (N, 12) [rad]."""
+    def ik_batch(self, feet: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
+        """IK_B of base-frame feet (N, 4, 3) [m]: q (N, 12) [rad], reached (N, 4)."""
+    def reachability_step(
+        self,
+        feet: ArrayLike,
+        base_pos: ArrayLike,
+        base_quat: ArrayLike,
+        alpha: float,
+        beta: float,
+    ) -> BodyPoseStep:
+        """Zucker 2011 §3.2: Δx = α Σ e_i, ω = β Σ (f'_i − x) × e_i."""
+    def point_pose_jacobians(
+        self,
+        feet: ArrayLike,
+        base_pos: ArrayLike,
+        base_quat: ArrayLike,
+        leg: int | None,
+        link: int,
+        point: ArrayLike,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """Zucker 2011 §3.4: world p (3,) [m], J_p(x), J_p(R) (3, 3) with feet held by IK.
+
+        ``leg=None`` means a trunk point given in the base frame; otherwise ``point``
+        is in the frame of ``link`` (0 hip, 1 thigh, 2 shank) of leg ``leg``.
+        """
+    def obstacle_avoidance_step(
+        self,
+        feet: ArrayLike,
+        base_pos: ArrayLike,
+        base_quat: ArrayLike,
+        leg: int | None,
+        link: int,
+        point: ArrayLike,
+        distance: float,
+        gradient: ArrayLike,
+        alpha: float,
+        beta: float,
+        clearance: float = 0.0,
+    ) -> BodyPoseStep:
+        """Zucker 2011 §3.4: Δx = α(c − d)·J_p(x)ᵀg, ω = β(c − d)·J_p(R)ᵀg while d < c."""
+    @staticmethod
+    def com_support_step(
+        stance_feet: ArrayLike,
+        base_pos: ArrayLike,
+        base_quat: ArrayLike,
+        com_offset: ArrayLike,
+        margin: float,
+        max_step: float,
+    ) -> BodyPoseStep:
+        """Move the CoM x + R·com_offset horizontally (≤ max_step [m]) to ``margin`` [m] inside."""
+
+def support_triangle_incircle(
+    a: ArrayLike, b: ArrayLike, c: ArrayLike
+) -> tuple[NDArray[np.float64], float]:
+    """Incircle centre (2,) [m] and radius [m] of the x–y triangle (a, b, c)."""
+
+def support_polygon_margin(point: ArrayLike, feet: ArrayLike) -> float:
+    """Signed x–y distance [m] from ``point`` to the convex hull of ``feet``: positive inside."""
