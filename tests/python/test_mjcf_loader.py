@@ -52,6 +52,7 @@ class Synthetic:
     drop_leg: str | None = None
     drop_joint: str | None = None  # leg whose KFE is removed
     slide_leg: str | None = None  # leg whose KFE is a slide joint
+    skew_knee: bool = False  # KFE axis not parallel to HFE's: no analytic IK
     head: str = ""  # extra XML inside the base body
     actuators: str = ""
     seed: int = 0
@@ -74,6 +75,8 @@ def synthetic_xml(opt: Synthetic) -> str:
             np.array([0.2 * fx, 0.16 * ly, -0.2]),
         ]
         axes = [np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0, -1.0 * ly, 0])]
+        if opt.skew_knee:
+            axes[2] = np.array([0.6, -0.8 * ly, 0.0])
         foot = np.array([0.2 * fx + 0.03 * fx, 0.16 * ly, -0.41])
         joints = [r_bc @ j for j in joints]
         axes = [r_bc @ a for a in axes]
@@ -275,6 +278,32 @@ def test_legs_and_joints_are_named_canonically(case: str, tmp_path: Path) -> Non
     for leg, hip in zip(LEGS, robot.hip_positions, strict=True):
         fx, ly = SIGN[leg]
         np.testing.assert_allclose(hip, [0.2 * fx, 0.1 * ly, 0.0], atol=1e-12)
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_inverse_kinematics_inverts_forward_kinematics(case: str, tmp_path: Path) -> None:
+    robot = load_synthetic(CASES[case], tmp_path)
+    rng = np.random.default_rng(4)
+    for _ in range(10):
+        q = rng.uniform(-1.5, 1.5, 12)
+        pose = random_free_pose(rng)
+        feet = robot.foot_positions(q, pose[:3], pose[3:])
+        q_ik, reachable = robot.inverse_kinematics(feet, pose[:3], pose[3:])
+        assert reachable.all()
+        assert np.all(q_ik >= robot.joint_lower) and np.all(q_ik <= robot.joint_upper)
+        np.testing.assert_allclose(robot.foot_positions(q_ik, pose[:3], pose[3:]), feet, atol=1e-9)
+
+
+def test_legs_without_analytic_ik_structure_keep_forward_kinematics(tmp_path: Path) -> None:
+    opt = Synthetic(skew_knee=True, twist=True, seed=12)
+    robot = load_synthetic(opt, tmp_path)
+    rng = np.random.default_rng(0)
+    q = random_q(robot, rng)
+    pose = random_free_pose(rng)
+    expected, base_pos, base_quat, _ = mujoco_feet(robot, opt, q, pose)
+    np.testing.assert_allclose(robot.foot_positions(q, base_pos, base_quat), expected, atol=1e-9)
+    with pytest.raises(RobotModelError, match="synthetic"):
+        robot.inverse_kinematics(expected, base_pos, base_quat)
 
 
 def test_qpos_and_base_pose_round_trip_through_mujoco(tmp_path: Path) -> None:

@@ -129,9 +129,6 @@ def test_third_party_anymal_forward_kinematics_equals_mujoco(reference_anymal_pa
     check_fk_against_mujoco(robot)
 
 
-@pytest.mark.skipif(
-    not hasattr(roughwalk._core, "Quadruped"), reason="Rust Quadruped binding not built"
-)
 def test_inverse_kinematics_round_trip(shipped: Robot) -> None:
     rng = np.random.default_rng(7)
     nominal = shipped.nominal_q
