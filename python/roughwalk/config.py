@@ -108,7 +108,7 @@ def override(config: C, changes: Mapping[str, Any]) -> C:
     for head, sub in nested.items():
         direct[head] = override(getattr(config, head), sub)
     try:
-        return dataclasses.replace(config, **direct)  # type: ignore[type-var]
+        return dataclasses.replace(config, **direct)
     except (ValueError, TypeError) as e:
         raise ConfigError(f"{type(config).__name__}: {e}") from None
 

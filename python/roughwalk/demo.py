@@ -24,7 +24,7 @@ def run_demo(
     sdf_resolution: float = 0.005,
     progress: Any = print,
 ) -> dict[str, Any]:
-    """Run the demo, write its pictures and ``summary.json`` into ``out_dir``; return the summary."""
+    """Run the demo, writing pictures and ``summary.json`` into ``out_dir``; return the summary."""
     from roughwalk.cli.common import result_envelope, write_json
     from roughwalk.viz.sdf_plot import save_sdf_slice_picture
     from roughwalk.viz.terrain_plot import save_terrain_picture

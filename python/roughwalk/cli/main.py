@@ -14,6 +14,7 @@ from roughwalk.errors import RoughwalkError
 COMMAND_MODULES = [
     "roughwalk.cli.terrain_cmd",
     "roughwalk.cli.sdf_cmd",
+    "roughwalk.cli.robot_cmd",
     "roughwalk.cli.demo_cmd",
 ]
 

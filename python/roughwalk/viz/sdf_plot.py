@@ -62,7 +62,9 @@ def save_sdf_slice_picture(
     fig.colorbar(im, ax=ax, fraction=0.03, pad=0.02, label="signed distance [m]")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("z [m]")
-    ax.set_title(f"{terrain.name}: SDF slice at y = {yy:.3f} m ({sdf.resolution * 1000:g} mm voxels)")
+    ax.set_title(
+        f"{terrain.name}: SDF slice at y = {yy:.3f} m ({sdf.resolution * 1000:g} mm voxels)"
+    )
     ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     Path(path).parent.mkdir(parents=True, exist_ok=True)
