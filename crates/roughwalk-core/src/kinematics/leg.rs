@@ -6,8 +6,8 @@
 
 use crate::error::{CoreError, CoreResult};
 use crate::kinematics::math::{
-    add, axis_angle, cross, dot, from_columns, mat_mul, mat_t_vec, mat_vec, norm, quat_normalize,
-    quat_to_mat, scale, solve, sub, wrap_angle, Mat3, Quat, Vec3,
+    add, axis_angle, cross, from_columns, mat_mul, mat_vec, norm, quat_normalize, quat_to_mat,
+    scale, sub, Mat3, Quat, Vec3,
 };
 
 /// The foot is "on" its target when it is this close [m].
@@ -15,14 +15,6 @@ pub const IK_TOLERANCE: f64 = 1e-9;
 
 /// Joint values this close to a limit [rad] count as on it (they are clamped onto it).
 const LIMIT_SLACK: f64 = 1e-9;
-
-/// Tolerance on the axis structure the analytic IK needs: |cos| of the angle
-/// between axes that must be perpendicular, |sin| between axes that must be parallel.
-const STRUCTURE_TOLERANCE: f64 = 1e-6;
-
-/// Targets farther than this from the hip [m] are pulled in along their direction
-/// before solving: no leg reaches that far, and it keeps squares finite.
-const FAR_TARGET: f64 = 1e3;
 
 /// The description of a leg, as a MuJoCo model states it.
 ///
@@ -86,29 +78,8 @@ pub struct IkResult {
     pub error: f64,
 }
 
-/// Geometry the analytic IK needs, fixed at construction. "Hip frame" is
-/// body 1's frame; vectors here are in it unless stated.
-#[derive(Debug, Clone, PartialEq)]
-struct IkGeometry {
-    /// HAA axis (exact, unit).
-    u1: Vec3,
-    /// HFE axis orthogonalised against u1: with u1 and w = u1 × n_perp, the
-    /// basis in which HAA rotates the foot.
-    n_perp: Vec3,
-    w: Vec3,
-    /// The foot's fixed offset along n_perp from the HAA anchor [m].
-    lateral: f64,
-    /// Planar basis ⟂ the HFE axis n, with e1 × e2 = n.
-    e1: Vec3,
-    e2: Vec3,
-    /// +1 when the KFE axis points along the HFE axis, −1 when against it.
-    knee_axis_sign: f64,
-    /// HFE anchor [m].
-    hfe_anchor: Vec3,
-    /// Thigh (HFE anchor → KFE anchor) and shank (KFE anchor → foot) at q = 0, in (e1, e2).
-    thigh: [f64; 2],
-    shank: [f64; 2],
-}
+mod closest;
+mod ik;
 
 /// A validated leg with its precomputed rotations and IK geometry.
 #[derive(Debug, Clone, PartialEq)]
@@ -118,7 +89,9 @@ pub struct LegChain {
     body_rot: [Mat3; 3],
     /// HAA anchor in the base frame [m].
     haa_anchor_base: Vec3,
-    ik_geometry: IkGeometry,
+    ik_geometry: ik::IkGeometry,
+    /// Arcs bounding the foot's reach in the HFE/KFE plane (see `closest`).
+    arcs: Vec<closest::PlanarArc>,
 }
 
 fn check_finite(name: &str, what: &str, values: &[f64]) -> CoreResult<()> {
@@ -136,36 +109,6 @@ fn unit(v: Vec3) -> Vec3 {
 
 fn clamp_to(q: Vec3, lower: Vec3, upper: Vec3) -> Vec3 {
     [0, 1, 2].map(|k| q[k].clamp(lower[k], upper[k]))
-}
-
-/// The representative q + 2πm inside [lower, upper] (the one nearest the
-/// bottom of the range), clamped onto it; `None` when there is none.
-fn wrap_into_limits(q: f64, lower: f64, upper: f64) -> Option<f64> {
-    let w = wrap_angle(q);
-    let lo = lower - LIMIT_SLACK;
-    let hi = upper + LIMIT_SLACK;
-    if (lo..=hi).contains(&w) {
-        return Some(w.clamp(lower, upper));
-    }
-    let tau = std::f64::consts::TAU;
-    let v = w + tau * ((lo - w) / tau).ceil();
-    (v <= hi).then(|| v.clamp(lower, upper))
-}
-
-/// The representative q + 2πm nearest to [lower, upper], clamped onto it.
-fn nearest_in_limits(q: f64, lower: f64, upper: f64) -> f64 {
-    if let Some(v) = wrap_into_limits(q, lower, upper) {
-        return v;
-    }
-    let tau = std::f64::consts::TAU;
-    let w = wrap_angle(q);
-    let above = w + tau * ((lower - w) / tau).ceil();
-    let below = above - tau;
-    if above - upper < lower - below {
-        upper
-    } else {
-        lower
-    }
 }
 
 impl LegChain {
@@ -228,68 +171,15 @@ impl LegChain {
         params.knee_sign = params.knee_sign.signum();
         let body_rot = params.body_quat.map(quat_to_mat);
         let haa_anchor_base = add(params.body_pos[0], mat_vec(&body_rot[0], params.anchor[0]));
-        let ik_geometry = Self::ik_geometry(name, &params, &body_rot)?;
+        let ik_geometry = ik::IkGeometry::new(name, &params, &body_rot)?;
+        let arcs = closest::planar_arcs(&ik_geometry, params.lower, params.upper);
         Ok(Self {
             name: name.to_owned(),
             params,
             body_rot,
             haa_anchor_base,
             ik_geometry,
-        })
-    }
-
-    fn ik_geometry(name: &str, p: &LegParams, body_rot: &[Mat3; 3]) -> CoreResult<IkGeometry> {
-        let u1 = p.axis[0];
-        let n = mat_vec(&body_rot[1], p.axis[1]);
-        let knee_axis = mat_vec(&body_rot[1], mat_vec(&body_rot[2], p.axis[2]));
-        let cos_haa_hfe = dot(u1, n);
-        if cos_haa_hfe.abs() > STRUCTURE_TOLERANCE {
-            return Err(CoreError::RobotModel(format!(
-                "leg '{name}': the HFE axis must be perpendicular to the HAA axis for the analytic IK, \
-                 but cos(angle) = {cos_haa_hfe:.3e} (tolerance {STRUCTURE_TOLERANCE:e})"
-            )));
-        }
-        let sin_hfe_kfe = norm(cross(n, knee_axis));
-        if sin_hfe_kfe > STRUCTURE_TOLERANCE {
-            return Err(CoreError::RobotModel(format!(
-                "leg '{name}': the KFE axis must be parallel to the HFE axis for the analytic IK, \
-                 but sin(angle) = {sin_hfe_kfe:.3e} (tolerance {STRUCTURE_TOLERANCE:e})"
-            )));
-        }
-        let knee_axis_sign = dot(n, knee_axis).signum();
-        let n_perp = unit(sub(n, scale(u1, cos_haa_hfe)));
-        let w = cross(u1, n_perp);
-        let e1 = unit(sub(u1, scale(n, cos_haa_hfe)));
-        let e2 = cross(n, e1);
-
-        // Positions in the hip frame at q_HFE = q_KFE = 0.
-        let in_hip = |v_thigh: Vec3| add(p.body_pos[1], mat_vec(&body_rot[1], v_thigh));
-        let hfe_anchor = add(p.body_pos[1], mat_vec(&body_rot[1], p.anchor[1]));
-        let kfe_anchor = in_hip(add(p.body_pos[2], mat_vec(&body_rot[2], p.anchor[2])));
-        let foot = in_hip(add(p.body_pos[2], mat_vec(&body_rot[2], p.foot)));
-        let planar = |v: Vec3| [dot(v, e1), dot(v, e2)];
-        let thigh = planar(sub(kfe_anchor, hfe_anchor));
-        let shank = planar(sub(foot, kfe_anchor));
-        for (what, v) in [("thigh (HFE→KFE)", thigh), ("shank (KFE→foot)", shank)] {
-            let len = v[0].hypot(v[1]);
-            if len < 1e-6 {
-                return Err(CoreError::RobotModel(format!(
-                    "leg '{name}': the {what} has length {len:.3e} m in the plane of the HFE and KFE \
-                     rotations; the leg cannot move its foot in that plane"
-                )));
-            }
-        }
-        Ok(IkGeometry {
-            u1,
-            n_perp,
-            w,
-            lateral: dot(n_perp, sub(foot, p.anchor[0])),
-            e1,
-            e2,
-            knee_axis_sign,
-            hfe_anchor,
-            thigh,
-            shank,
+            arcs,
         })
     }
 
@@ -386,267 +276,6 @@ impl LegChain {
         let p = add(f.pos[link], mat_vec(&f.rot[link], point));
         Ok((p, Self::columns(&f, p, link)))
     }
-
-    /// Inverse kinematics IK_B: joint angles placing the foot centre at
-    /// `target` (base frame [m]), or, when that is impossible within the joint
-    /// limits, the joint angles within limits whose foot is closest to it.
-    ///
-    /// `knee_sign` (±1) overrides the leg's preferred knee branch (see
-    /// [`LegParams::knee_sign`]); the other branch is used only when the
-    /// preferred one violates a limit. Never panics and never returns NaN.
-    pub fn ik(&self, target: Vec3, knee_sign: Option<f64>) -> IkResult {
-        if !target.iter().all(|v| v.is_finite()) {
-            return IkResult {
-                q: self.nominal(),
-                reachable: false,
-                within_limits: true,
-                error: f64::INFINITY,
-            };
-        }
-        let knee = if knee_sign.unwrap_or(self.params.knee_sign) < 0.0 {
-            -1.0
-        } else {
-            1.0
-        };
-        let from_hip = sub(target, self.haa_anchor_base);
-        let dist = norm(from_hip);
-        let solve_target = if dist > FAR_TARGET {
-            add(self.haa_anchor_base, scale(from_hip, FAR_TARGET / dist))
-        } else {
-            target
-        };
-        let candidates = self.analytic_candidates(solve_target, knee);
-        for (q, _) in &candidates {
-            let wrapped = [0, 1, 2]
-                .map(|k| wrap_into_limits(q[k], self.params.lower[k], self.params.upper[k]));
-            if let [Some(a), Some(b), Some(c)] = wrapped {
-                let (q, error) = self.polish([a, b, c], target);
-                if error <= IK_TOLERANCE {
-                    return IkResult {
-                        q,
-                        reachable: true,
-                        within_limits: true,
-                        error,
-                    };
-                }
-            }
-        }
-        let (q, _) = self.closest_within_limits(solve_target, &candidates);
-        let error = norm(sub(self.fk(q), target));
-        let reachable = error <= IK_TOLERANCE;
-        let on_limit = (0..3).any(|k| {
-            q[k] <= self.params.lower[k] + LIMIT_SLACK || q[k] >= self.params.upper[k] - LIMIT_SLACK
-        });
-        IkResult {
-            q,
-            reachable,
-            within_limits: reachable || !on_limit,
-            error,
-        }
-    }
-
-    /// The four analytic solutions (2 HAA × 2 knee branches) of the limit-free
-    /// chain, most preferred first, each with whether it is exact. A target
-    /// out of the chain's reach is first moved to the nearest point of reach,
-    /// stage by stage, so every candidate is finite.
-    fn analytic_candidates(&self, target: Vec3, knee: f64) -> [(Vec3, bool); 4] {
-        let g = &self.ik_geometry;
-        let p = &self.params;
-        // Rotating about HAA moves the foot on a circle about the HAA axis at a
-        // fixed offset `lateral` along the HFE axis: solve HAA from the target's
-        // polar angle about that axis (two solutions, ±v_w).
-        let t = mat_t_vec(&self.body_rot[0], sub(target, self.haa_anchor_base));
-        let (t_u, t_n, t_w) = (dot(t, g.u1), dot(t, g.n_perp), dot(t, g.w));
-        let v_w2 = t_n * t_n + t_w * t_w - g.lateral * g.lateral;
-        let haa_exact = v_w2 >= 0.0;
-        let v_w_abs = v_w2.max(0.0).sqrt();
-        let nominal_haa = self.nominal()[0];
-        let mut haa = [v_w_abs, -v_w_abs].map(|v_w| (v_w, t_w.atan2(t_n) - v_w.atan2(g.lateral)));
-        if wrap_angle(haa[0].1 - nominal_haa).abs() > wrap_angle(haa[1].1 - nominal_haa).abs() {
-            haa.swap(0, 1);
-        }
-        let mut out = [([0.0; 3], false); 4];
-        for (i, &(v_w, q1)) in haa.iter().enumerate() {
-            // The HFE/KFE plane problem, in the hip frame: the two-link chain
-            // thigh + Rot(φ)·shank, rotated by q2, must reach d (law of cosines).
-            let foot_hip = add(
-                p.anchor[0],
-                add(
-                    add(scale(g.u1, t_u), scale(g.n_perp, g.lateral)),
-                    scale(g.w, v_w),
-                ),
-            );
-            let rel = sub(foot_hip, g.hfe_anchor);
-            let d = [dot(rel, g.e1), dot(rel, g.e2)];
-            let l1 = g.thigh[0].hypot(g.thigh[1]);
-            let l2 = g.shank[0].hypot(g.shank[1]);
-            let cos_psi = (d[0] * d[0] + d[1] * d[1] - l1 * l1 - l2 * l2) / (2.0 * l1 * l2);
-            let planar_exact = (-1.0..=1.0).contains(&cos_psi);
-            let psi_abs = cos_psi.clamp(-1.0, 1.0).acos();
-            let alpha1 = g.thigh[1].atan2(g.thigh[0]);
-            let alpha2 = g.shank[1].atan2(g.shank[0]);
-            for (j, branch) in [knee, -knee].into_iter().enumerate() {
-                let phi = branch * psi_abs + alpha1 - alpha2;
-                let (s, c) = phi.sin_cos();
-                let m = [
-                    g.thigh[0] + c * g.shank[0] - s * g.shank[1],
-                    g.thigh[1] + s * g.shank[0] + c * g.shank[1],
-                ];
-                let q2 = d[1].atan2(d[0]) - m[1].atan2(m[0]);
-                let q3 = g.knee_axis_sign * phi;
-                out[2 * i + j] = ([q1, q2, q3], haa_exact && planar_exact);
-            }
-        }
-        out
-    }
-
-    /// A few Newton steps from an analytic solution, to take out the error of
-    /// a slightly imperfect axis structure or of acos near a straight knee.
-    fn polish(&self, q: Vec3, target: Vec3) -> (Vec3, f64) {
-        let (lower, upper) = (self.params.lower, self.params.upper);
-        let (mut q, mut foot_jac) = (q, self.fk_and_jacobian(q));
-        let mut error = norm(sub(foot_jac.0, target));
-        for _ in 0..4 {
-            if error <= 1e-14 {
-                break;
-            }
-            let Some(dq) = solve(&foot_jac.1, sub(target, foot_jac.0)) else {
-                break;
-            };
-            let q_new = clamp_to(add(q, dq), lower, upper);
-            let fj = self.fk_and_jacobian(q_new);
-            let e_new = norm(sub(fj.0, target));
-            if !e_new.is_finite() || e_new >= error {
-                break;
-            }
-            (q, foot_jac, error) = (q_new, fj, e_new);
-        }
-        (q, error)
-    }
-
-    /// The joint angles within limits whose foot is closest to `target`:
-    /// projected Levenberg–Marquardt from several starts (the analytic
-    /// candidates moved into the limits, the nominal pose, and the best point
-    /// of a coarse grid over the limits), keeping the best.
-    fn closest_within_limits(&self, target: Vec3, candidates: &[(Vec3, bool); 4]) -> (Vec3, f64) {
-        let (lower, upper) = (self.params.lower, self.params.upper);
-        let mut seeds: Vec<Vec3> = candidates
-            .iter()
-            .map(|(q, _)| [0, 1, 2].map(|k| nearest_in_limits(q[k], lower[k], upper[k])))
-            .collect();
-        seeds.push(self.nominal());
-        seeds.push(self.grid_seed(target));
-        let mut best = (self.nominal(), f64::INFINITY);
-        for seed in seeds {
-            let (q, err) = self.projected_lm(seed, target);
-            if err < best.1 {
-                best = (q, err);
-            }
-        }
-        best
-    }
-
-    /// The best foot-to-target distance over a 7×7×7 grid spanning the limits
-    /// (or a full turn for unlimited joints): a start that no analytic
-    /// candidate may be near when limits cut the workspace into pieces.
-    fn grid_seed(&self, target: Vec3) -> Vec3 {
-        const N: usize = 7;
-        let (lower, upper) = (self.params.lower, self.params.upper);
-        let span = |k: usize| {
-            let lo = if lower[k].is_finite() {
-                lower[k]
-            } else {
-                -std::f64::consts::PI
-            };
-            let hi = if upper[k].is_finite() {
-                upper[k]
-            } else {
-                lo + std::f64::consts::TAU
-            };
-            (lo, (hi - lo).min(std::f64::consts::TAU))
-        };
-        let spans = [span(0), span(1), span(2)];
-        let at = |k: usize, i: usize| spans[k].0 + spans[k].1 * i as f64 / (N - 1) as f64;
-        let mut best = (self.nominal(), f64::INFINITY);
-        for i in 0..N {
-            for j in 0..N {
-                for l in 0..N {
-                    let q = clamp_to([at(0, i), at(1, j), at(2, l)], lower, upper);
-                    let e = norm(sub(self.fk(q), target));
-                    if e < best.1 {
-                        best = (q, e);
-                    }
-                }
-            }
-        }
-        best.0
-    }
-
-    /// Levenberg–Marquardt on ½|FK(q) − target|² with the joints on an active
-    /// limit (pushed outward by the gradient) held fixed, every step clamped
-    /// into the box and accepted only if it reduces the distance.
-    fn projected_lm(&self, seed: Vec3, target: Vec3) -> (Vec3, f64) {
-        let (lower, upper) = (self.params.lower, self.params.upper);
-        let mut q = clamp_to(seed, lower, upper);
-        let (foot, mut jac) = self.fk_and_jacobian(q);
-        let mut e = sub(target, foot);
-        let mut cost = dot(e, e);
-        let mut lambda = 1e-3;
-        for _ in 0..100 {
-            let grad = mat_t_vec(&jac, e);
-            let free = [0, 1, 2].map(|k| {
-                !((q[k] <= lower[k] && grad[k] < 0.0) || (q[k] >= upper[k] && grad[k] > 0.0))
-            });
-            let mut h = [[0.0; 3]; 3];
-            for r in 0..3 {
-                for c in 0..3 {
-                    h[r][c] = if free[r] && free[c] {
-                        (0..3).map(|i| jac[i][r] * jac[i][c]).sum()
-                    } else {
-                        0.0
-                    };
-                }
-            }
-            let g = [0, 1, 2].map(|k| if free[k] { grad[k] } else { 0.0 });
-            if norm(g) <= 1e-15 * (1.0 + cost.sqrt()) {
-                break;
-            }
-            let scale_h = (h[0][0] + h[1][1] + h[2][2]).max(1e-12) / 3.0;
-            let mut improved = false;
-            while lambda < 1e12 {
-                let mut damped = h;
-                for k in 0..3 {
-                    damped[k][k] += if free[k] {
-                        lambda * (h[k][k] + scale_h)
-                    } else {
-                        1.0
-                    };
-                }
-                let Some(dq) = solve(&damped, g) else {
-                    lambda *= 10.0;
-                    continue;
-                };
-                let q_new = clamp_to(add(q, dq), lower, upper);
-                let (f_new, j_new) = self.fk_and_jacobian(q_new);
-                let e_new = sub(target, f_new);
-                let cost_new = dot(e_new, e_new);
-                if cost_new < cost {
-                    let step = norm(sub(q_new, q));
-                    (q, jac, e) = (q_new, j_new, e_new);
-                    let gain = cost - cost_new;
-                    cost = cost_new;
-                    lambda = (lambda / 5.0).max(1e-9);
-                    improved = gain > 1e-30 && step > 1e-15;
-                    break;
-                }
-                lambda *= 5.0;
-            }
-            if !improved {
-                break;
-            }
-        }
-        (q, cost.sqrt())
-    }
 }
 
 #[cfg(test)]
@@ -654,8 +283,7 @@ impl LegChain {
 #[allow(clippy::float_cmp)]
 pub(crate) mod tests {
     use super::*;
-    use crate::kinematics::math::{axis_angle as rot, mat_to_quat};
-    use proptest::prelude::*;
+    use crate::kinematics::math::{axis_angle as rot, mat_t_vec, mat_to_quat};
 
     /// A LittleDog-sized leg (URDF numbers), x = forward, y = left, z = up.
     pub fn littledog_leg(side: f64, front: bool) -> LegChain {
@@ -748,7 +376,7 @@ pub(crate) mod tests {
         ]
     }
 
-    fn finite_difference(f: impl Fn(Vec3) -> Vec3, q: Vec3) -> Mat3 {
+    pub fn finite_difference(f: impl Fn(Vec3) -> Vec3, q: Vec3) -> Mat3 {
         let h = 1e-6;
         let cols = [0, 1, 2].map(|k| {
             let mut qp = q;
@@ -776,7 +404,7 @@ pub(crate) mod tests {
         }
     }
 
-    fn sample_q(leg: &LegChain, u: Vec3) -> Vec3 {
+    pub fn sample_q(leg: &LegChain, u: Vec3) -> Vec3 {
         let p = leg.params();
         [0, 1, 2].map(|k| p.lower[k] + u[k] * (p.upper[k] - p.lower[k]))
     }
@@ -824,123 +452,81 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn structure_check_names_the_leg() {
-        let mut p = skewed_leg().params().clone();
-        p.axis[2] = [0.0, 0.0, 1.0];
-        let err = LegChain::new("RH", p).unwrap_err();
-        assert!(
-            matches!(&err, CoreError::RobotModel(m) if m.contains("'RH'") && m.contains("KFE"))
-        );
-        let mut p = littledog_leg(1.0, true).params().clone();
-        p.axis[1] = [1.0, 0.0, 0.0];
-        p.axis[2] = [1.0, 0.0, 0.0];
-        let err = LegChain::new("LF", p).unwrap_err();
-        assert!(
-            matches!(&err, CoreError::RobotModel(m) if m.contains("'LF'") && m.contains("perpendicular"))
-        );
-        let mut p = littledog_leg(1.0, true).params().clone();
+    fn bad_descriptions_are_refused() {
+        let good = littledog_leg(1.0, true).params().clone();
+        let mut p = good.clone();
         p.lower[1] = 3.0;
+        assert!(
+            matches!(LegChain::new("LF", p), Err(CoreError::RobotModel(m)) if m.contains("joint 1 limits"))
+        );
+        let mut p = good.clone();
+        p.body_quat[2] = [0.0; 4];
+        assert!(LegChain::new("LF", p).is_err());
+        let mut p = good.clone();
+        p.foot[0] = f64::NAN;
+        assert!(LegChain::new("LF", p).is_err());
+        let mut p = good;
+        p.knee_sign = 0.0;
         assert!(LegChain::new("LF", p).is_err());
     }
 
-    #[test]
-    fn knee_sign_selects_the_branch() {
-        // LittleDog front leg: ψ = q_KFE + 0.263 (the shin's backward offset), so
-        // the mirror of q_KFE = −1.2 (ψ = −0.937) is q_KFE = 0.674, inside the limit of 1.0.
-        let leg = littledog_leg(1.0, true);
-        let q = [0.1, 0.4, -1.2];
-        let f = leg.fk(q);
-        let minus = leg.ik(f, Some(-1.0));
-        assert!(minus.reachable && norm(sub(minus.q, q)) < 1e-9, "{minus:?}");
-        let plus = leg.ik(f, Some(1.0));
-        assert!(
-            plus.reachable && (plus.q[2] - 0.674).abs() < 2e-3,
-            "{plus:?}"
-        );
-        // The mirror of q_KFE = −2.0 would need q_KFE = 1.47 > 1.0: the preferred
-        // branch is then dropped for the one that fits.
-        let q = [0.1, -0.2, -2.0];
-        let fallback = leg.ik(leg.fk(q), Some(1.0));
-        assert!(
-            fallback.reachable && norm(sub(fallback.q, q)) < 1e-9,
-            "{fallback:?}"
-        );
-    }
+    /// A small seeded generator for random legs.
+    struct Rng(u64);
 
-    #[test]
-    fn degenerate_targets_give_finite_answers() {
-        for leg in test_legs() {
-            let hip = leg.haa_anchor_base;
-            for target in [
-                hip,
-                [0.0; 3],
-                [1e300, -1e300, 1e300],
-                [f64::MAX, 0.0, 0.0],
-                add(hip, [0.0, 0.0, 5.0]),
-                [f64::NAN, 0.0, 0.0],
-                [f64::INFINITY, 0.0, 0.0],
-            ] {
-                let r = leg.ik(target, None);
-                assert!(r.q.iter().all(|v| v.is_finite()), "{target:?} → {r:?}");
-                assert!(leg.is_within_limits(r.q));
-                assert!(!r.reachable);
-                assert!(!r.error.is_nan());
-            }
+    impl Rng {
+        fn uniform(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            2.0 * ((self.0 >> 11) as f64 / (1u64 << 53) as f64) - 1.0
+        }
+
+        fn vec3(&mut self) -> Vec3 {
+            [self.uniform(), self.uniform(), self.uniform()]
         }
     }
 
-    /// Best foot-to-target distance over a dense grid of joint angles within limits.
-    fn brute_force_distance(leg: &LegChain, target: Vec3, n: usize) -> f64 {
-        let mut best = f64::INFINITY;
-        for i in 0..n {
-            for j in 0..n {
-                for k in 0..n {
-                    let u = [i, j, k].map(|v| v as f64 / (n - 1) as f64);
-                    best = best.min(norm(sub(leg.fk(sample_q(leg, u)), target)));
-                }
-            }
-        }
-        best
-    }
-
-    #[test]
-    fn out_of_reach_targets_get_the_closest_reachable_foot() {
-        let mut rng = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for leg in test_legs() {
-            for _ in 0..12 {
-                let dir = unit([next() - 0.5, next() - 0.5, next() - 0.5]);
-                let target = add(leg.haa_anchor_base, scale(dir, 0.15 + 0.5 * next()));
-                let r = leg.ik(target, None);
-                let brute = brute_force_distance(&leg, target, 41);
-                assert!(
-                    r.error <= brute + 1e-9,
-                    "{}: ik {} > brute {brute} for {target:?}",
-                    leg.name(),
-                    r.error
-                );
-                assert!(leg.is_within_limits(r.q));
-                assert_eq!(r.reachable, r.error <= IK_TOLERANCE);
-            }
-        }
-    }
-
-    proptest! {
-        #[test]
-        fn ik_inverts_fk_inside_the_workspace(u in prop::array::uniform3(0.0..=1.0f64), which in 0usize..6) {
-            let leg = &test_legs()[which];
-            let q = sample_q(leg, u);
-            let f = leg.fk(q);
-            let r = leg.ik(f, None);
-            prop_assert!(r.reachable, "{q:?} → {r:?}");
-            prop_assert!(r.within_limits);
-            prop_assert!(leg.is_within_limits(r.q));
-            prop_assert!(norm(sub(leg.fk(r.q), f)) <= 1e-9);
-        }
+    /// A random leg with the IK's axis structure (HFE ∥ KFE ⟂ HAA): random
+    /// body rotations, anchors, offsets, limits and knee-axis direction.
+    pub fn random_leg(seed: u64) -> LegChain {
+        let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+        let quats: [Quat; 3] = std::array::from_fn(|_| {
+            let q = [rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform()];
+            quat_normalize(q).unwrap_or([1.0, 0.0, 0.0, 0.0])
+        });
+        let rots = quats.map(quat_to_mat);
+        let haa = unit(rng.vec3());
+        let hfe_in_hip = unit(cross(haa, rng.vec3()));
+        let hfe = mat_t_vec(&rots[1], hfe_in_hip);
+        let flip = if rng.uniform() < 0.0 { -1.0 } else { 1.0 };
+        let kfe = scale(mat_t_vec(&rots[2], hfe), flip);
+        let thigh = add(scale(rng.vec3(), 0.15), scale(unit(rng.vec3()), 0.2));
+        let foot = add(scale(rng.vec3(), 0.05), scale(unit(rng.vec3()), 0.22));
+        let width = [
+            0.8 + 0.4 * rng.uniform(),
+            2.5 + rng.uniform(),
+            2.5 + rng.uniform(),
+        ];
+        let centre = [
+            0.2 * rng.uniform(),
+            0.5 * rng.uniform(),
+            0.5 * rng.uniform(),
+        ];
+        LegChain::new(
+            &format!("random{seed}"),
+            LegParams {
+                body_pos: [scale(rng.vec3(), 0.2), scale(rng.vec3(), 0.06), thigh],
+                body_quat: quats,
+                anchor: std::array::from_fn(|_| scale(rng.vec3(), 0.03)),
+                axis: [haa, hfe, kfe],
+                lower: std::array::from_fn(|k| centre[k] - width[k]),
+                upper: std::array::from_fn(|k| centre[k] + width[k]),
+                velocity_limit: [10.0; 3],
+                foot,
+                foot_radius: 0.01,
+                knee_sign: 1.0,
+            },
+        )
+        .unwrap()
     }
 }
