@@ -67,13 +67,13 @@ fn single_leg(c: &mut Criterion) {
     group.throughput(Throughput::Elements(1));
     group.bench_function("fk", |b| b.iter(|| leg.fk(black_box(q))));
     group.bench_function("fk_and_jacobian", |b| {
-        b.iter(|| leg.fk_and_jacobian(black_box(q)))
+        b.iter(|| leg.fk_and_jacobian(black_box(q)));
     });
     group.bench_function("ik_reachable", |b| {
-        b.iter(|| leg.ik(black_box(reachable), None))
+        b.iter(|| leg.ik(black_box(reachable), None));
     });
     group.bench_function("ik_out_of_reach", |b| {
-        b.iter(|| leg.ik(black_box(out_of_reach), None))
+        b.iter(|| leg.ik(black_box(out_of_reach), None));
     });
     group.finish();
 }
@@ -92,11 +92,11 @@ fn quadruped(c: &mut Criterion) {
             link: 2,
             point: [0.0, 0.0, -0.05],
         };
-        b.iter(|| point_pose_jacobians(&robot, black_box(&feet_world), pos, quat, point))
+        b.iter(|| point_pose_jacobians(&robot, black_box(&feet_world), pos, quat, point));
     });
     group.throughput(Throughput::Elements(4 * batch.len() as u64));
     group.bench_function("ik_batch_1000x4", |b| {
-        b.iter(|| robot.ik_batch(black_box(&batch)))
+        b.iter(|| robot.ik_batch(black_box(&batch)));
     });
     group.finish();
 }

@@ -2,6 +2,9 @@
 //! FK/IK (single and batched), the body-pose steps and the support-polygon
 //! helpers. Arrays in and out are float64 numpy arrays; any array-like is accepted.
 
+// PyO3 extracts every argument by value; borrowing them is not an option.
+#![allow(clippy::needless_pass_by_value)]
+
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyList;
