@@ -6,6 +6,7 @@
 
 pub mod dubins;
 pub mod error;
+pub mod footstep;
 pub mod heightfield;
 pub mod kinematics;
 pub mod sdf;

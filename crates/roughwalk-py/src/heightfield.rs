@@ -1,6 +1,6 @@
 //! Bindings for `roughwalk_core::HeightField`: batched height and normal queries.
 
-use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use roughwalk_core::{HeightField, Interpolation};
 
@@ -10,9 +10,11 @@ pub fn parse_interp(name: &str) -> PyResult<Interpolation> {
     match name {
         "bilinear" => Ok(Interpolation::Bilinear),
         "bicubic" => Ok(Interpolation::Bicubic),
-        other => Err(crate::errors::to_py(roughwalk_core::CoreError::InvalidArgument(format!(
-            "unknown interpolation '{other}'; known: bilinear, bicubic"
-        )))),
+        other => Err(crate::errors::to_py(
+            roughwalk_core::CoreError::InvalidArgument(format!(
+                "unknown interpolation '{other}'; known: bilinear, bicubic"
+            )),
+        )),
     }
 }
 
@@ -41,7 +43,11 @@ impl PyHeightField {
             Some(k) => {
                 if k.shape() != shape {
                     return Err(crate::errors::to_py(roughwalk_core::CoreError::Terrain(
-                        format!("known mask shape {:?} differs from heights shape {:?}", k.shape(), shape),
+                        format!(
+                            "known mask shape {:?} differs from heights shape {:?}",
+                            k.shape(),
+                            shape
+                        ),
                     )));
                 }
                 Some(k.as_array().iter().copied().collect())
@@ -63,7 +69,11 @@ impl PyHeightField {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let interp = parse_interp(interpolation)?;
         let pts = xy_rows(&xy)?;
-        let out: Vec<f64> = py.detach(|| pts.iter().map(|&(x, y)| self.inner.height(x, y, interp)).collect());
+        let out: Vec<f64> = py.detach(|| {
+            pts.iter()
+                .map(|&(x, y)| self.inner.height(x, y, interp))
+                .collect()
+        });
         Ok(PyArray1::from_vec(py, out))
     }
 
@@ -90,9 +100,16 @@ impl PyHeightField {
     }
 
     /// Whether each (N, 2) point lies over a fully measured grid cell.
-    fn is_known<'py>(&self, py: Python<'py>, xy: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    fn is_known<'py>(
+        &self,
+        py: Python<'py>,
+        xy: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<bool>>> {
         let pts = xy_rows(&xy)?;
-        let out: Vec<bool> = pts.iter().map(|&(x, y)| self.inner.is_known(x, y)).collect();
+        let out: Vec<bool> = pts
+            .iter()
+            .map(|&(x, y)| self.inner.is_known(x, y))
+            .collect();
         Ok(PyArray1::from_vec(py, out))
     }
 
@@ -107,26 +124,27 @@ impl PyHeightField {
 pub fn xy_rows(xy: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<(f64, f64)>> {
     let a = xy.as_array();
     if a.ncols() != 2 {
-        return Err(crate::errors::to_py(roughwalk_core::CoreError::InvalidArgument(format!(
-            "expected points of shape (N, 2), got {:?}",
-            a.shape()
-        ))));
+        return Err(crate::errors::to_py(
+            roughwalk_core::CoreError::InvalidArgument(format!(
+                "expected points of shape (N, 2), got {:?}",
+                a.shape()
+            )),
+        ));
     }
     let mut out = Vec::with_capacity(a.nrows());
     for (i, r) in a.rows().into_iter().enumerate() {
         if !(r[0].is_finite() && r[1].is_finite()) {
-            return Err(crate::errors::to_py(roughwalk_core::CoreError::InvalidArgument(format!(
-                "point {i} is not finite: ({}, {})",
-                r[0], r[1]
-            ))));
+            return Err(crate::errors::to_py(
+                roughwalk_core::CoreError::InvalidArgument(format!(
+                    "point {i} is not finite: ({}, {})",
+                    r[0], r[1]
+                )),
+            ));
         }
         out.push((r[0], r[1]));
     }
     Ok(out)
 }
-
-#[allow(dead_code)]
-fn _unused(_: PyReadonlyArray1<'_, f64>) {}
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyHeightField>()
