@@ -214,7 +214,9 @@ class TerrainCost:
         """Cost of footholds ``xy`` (N, 2) [m], features interpolated bilinearly.
 
         ``heading`` [rad] (scalar or (N,)) is needed by an oriented cost and
-        ignored otherwise. Footholds off the grid or near unknown cells cost +inf.
+        ignored otherwise. Footholds off the grid or near unknown cells cost +inf:
+        a point is usable only if all four cells around it are valid, so at the
+        edge of the valid region this is one cell more cautious than :meth:`cost_map`.
         """
         self._check_heading(heading)
         self._check_features(terrain_features)
