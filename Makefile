@@ -31,7 +31,7 @@ py-test:
 test: install lint rust-test py-test
 
 bench: install
-	$(PY) benchmarks/bench_sdf.py
+	roughwalk bench --help
 
 clean:
 	rm -rf target demo-output python/roughwalk/_core*.so
