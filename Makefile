@@ -11,6 +11,11 @@ PYTEST_WORKERS ?= 2
 install:
 	$(PIP) install --quiet 'maturin>=1.7,<2'
 	$(PIP) install --quiet --no-build-isolation -e '.[dev]'
+	@# Debian's chromium drives the labelling app's browser test (Playwright cannot download its own).
+	@command -v chromium >/dev/null 2>&1 || { if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) \
+	  || echo "note: could not install chromium; the labelling app's browser test will skip"; \
+	else echo "note: chromium is not installed (needs root and apt-get); the labelling app's browser test will skip"; fi; }
 
 demo: install
 	roughwalk demo --out-dir demo-output
