@@ -204,3 +204,22 @@ def test_shipped_default_agrees_with_the_expert_on_unseen_terrains() -> None:
         [Preference(p.a, p.b, p.leg, lab) for p, lab in zip(pairs, labels, strict=True)], feats
     )
     assert agreement(cost, data) >= 0.88
+
+
+def test_features_in_any_frame_give_the_same_costs(rocks: Terrain) -> None:
+    # Precomputed features may come in a heading frame; each cost turns them
+    # into the frame its weights expect.
+    for oriented in (False, True):
+        cost = random_cost(oriented=oriented, seed=5)
+        heading = 0.7 if oriented else None
+        reference = cost.cost_map(rocks, heading=heading)
+        for frame in (None, -1.2, 0.7):
+            feats = compute_features(rocks, radii=RADII, oriented_heading=frame)
+            grid = cost.cost_map(rocks, heading=heading, features=feats)
+            np.testing.assert_allclose(grid, reference, rtol=1e-9)
+            xy = np.array([[0.3, 0.05], [0.52, -0.1]])
+            np.testing.assert_allclose(
+                cost.cost_at(feats, xy, heading=heading),
+                cost.cost_at(cost.features_for(rocks), xy, heading=heading),
+                rtol=1e-9,
+            )

@@ -31,6 +31,7 @@ __all__ = [
     "agreement",
     "INVARIANT_FEATURES",
     "feature_mask",
+    "with_seed",
 ]
 
 # Features that do not change when the ground turns under the robot: the fit's

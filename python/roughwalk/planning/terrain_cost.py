@@ -25,7 +25,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from roughwalk.errors import InvalidArgumentError, PlanningError
-from roughwalk.terrain.features import FEATURE_NAMES, TerrainFeatures, compute_features
+from roughwalk.terrain.features import (
+    FEATURE_NAMES,
+    TerrainFeatures,
+    compute_features,
+    orient_features,
+)
 from roughwalk.terrain.terrain import Terrain
 
 __all__ = [
@@ -196,10 +201,11 @@ class TerrainCost:
                 f"features of shape {features.shape} do not match the terrain {terrain.shape}"
             )
         values = features.values
-        if use_heading is not None and features.heading != use_heading:
-            from roughwalk.terrain.features import orient_features
-
-            values = orient_features(values, use_heading - (features.heading or 0.0))
+        # The weights expect the heading frame (oriented) or the world frame.
+        target = use_heading if use_heading is not None else 0.0
+        current = features.heading or 0.0
+        if target != current:
+            values = orient_features(values, target - current)
         out = self.cost(values, leg)
         out[~features.valid] = np.inf
         return out
@@ -223,7 +229,11 @@ class TerrainCost:
         points = np.asarray(xy, dtype=np.float64)
         if points.ndim == 1 and points.shape == (2,):
             points = points[None, :]
-        f = terrain_features.at(points, heading=heading if self.oriented else None)
+        if self.oriented:
+            f = terrain_features.at(points, heading=heading)
+        else:
+            # Features computed in some heading frame go back to the world frame.
+            f = terrain_features.at(points, heading=0.0 if terrain_features.heading else None)
         out = self.cost(f, leg)
         out[~terrain_features.valid_at(points)] = np.inf
         return out
