@@ -29,6 +29,70 @@ class HeightField:
 
 # ---- sdf (crates/roughwalk-py/src/sdf.rs) ----
 
+class SdfBand:
+    """A signed distance field half built: occupancy and exact band done."""
+
+    @staticmethod
+    def from_heightfield(
+        heightfield: HeightField,
+        origin: tuple[float, float, float],
+        resolution: float,
+        shape: tuple[int, int, int],
+        band_cells: float,
+    ) -> SdfBand: ...
+    @staticmethod
+    def from_mesh(
+        heightfield: HeightField,
+        vertices: NDArray[np.float64],
+        faces: NDArray[np.int64],
+        origin: tuple[float, float, float],
+        resolution: float,
+        shape: tuple[int, int, int],
+        band_cells: float,
+    ) -> SdfBand: ...
+    def seed_mask(self, max_distance: float | None = None) -> NDArray[np.bool_]: ...
+    @property
+    def exact_count(self) -> int: ...
+    def finish(self) -> SdfField: ...
+    def finish_with_nearest_voxel(self, nearest: NDArray[np.int64]) -> SdfField: ...
+    def finish_with_seed_distance(
+        self, seed_distance: NDArray[np.float32], offset: float
+    ) -> SdfField: ...
+
+class SdfField:
+    """A built signed distance field: lattice values [m] and the height-field fall-back."""
+
+    def __init__(
+        self,
+        heightfield: HeightField,
+        origin: tuple[float, ...],
+        resolution: float,
+        values: NDArray[np.float32],
+    ) -> None: ...
+    def query(
+        self, points: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+    def surface_query(
+        self, points: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+    def query_spheres(
+        self, centers: NDArray[np.float64], radii: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+    def query_capsules(
+        self,
+        a: NDArray[np.float64],
+        b: NDArray[np.float64],
+        radii: NDArray[np.float64],
+        samples: int | None = None,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
+    def values(self) -> NDArray[np.float32]: ...
+    @property
+    def origin(self) -> tuple[float, float, float]: ...
+    @property
+    def resolution(self) -> float: ...
+    @property
+    def shape(self) -> tuple[int, int, int]: ...
+
 # ---- robot kinematics (crates/roughwalk-py/src/robot.rs) ----
 
 class LegChain:

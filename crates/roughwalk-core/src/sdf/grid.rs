@@ -1,0 +1,292 @@
+//! The voxel lattice of a signed distance field and trilinear interpolation
+//! of the values stored at its nodes.
+//!
+//! Values live at lattice nodes `origin + (i, j, k)·resolution`, stored
+//! C-order with z fastest: `index = (i·ny + j)·nz + k`. A query inside the
+//! node box is the trilinear interpolant of the cell's eight corners; its
+//! gradient is the interpolant's own analytic gradient, so that finite
+//! differences of the field reproduce it.
+
+use crate::error::{CoreError, CoreResult};
+
+/// Position, spacing and size of a uniform voxel lattice.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridSpec {
+    /// Position [m] of node (0, 0, 0).
+    pub origin: [f64; 3],
+    /// Node spacing [m], the same along x, y and z.
+    pub resolution: f64,
+    /// Number of nodes along x, y and z.
+    pub shape: [usize; 3],
+}
+
+impl GridSpec {
+    /// Checks and builds a lattice: finite origin, positive resolution, at
+    /// least two nodes per axis, and few enough nodes to index with `u32`.
+    pub fn new(origin: [f64; 3], resolution: f64, shape: [usize; 3]) -> CoreResult<Self> {
+        if !origin.iter().all(|v| v.is_finite()) {
+            return Err(CoreError::Terrain(format!(
+                "SDF grid origin must be finite, got {origin:?}"
+            )));
+        }
+        if !(resolution.is_finite() && resolution > 0.0) {
+            return Err(CoreError::Terrain(format!(
+                "SDF resolution must be a positive number of metres, got {resolution}"
+            )));
+        }
+        if shape.iter().any(|&n| n < 2) {
+            return Err(CoreError::Terrain(format!(
+                "SDF grid needs at least 2 nodes along each axis, got shape {shape:?}"
+            )));
+        }
+        let total = shape
+            .iter()
+            .try_fold(1usize, |acc, &n| acc.checked_mul(n))
+            .filter(|&t| t < u32::MAX as usize);
+        if total.is_none() {
+            return Err(CoreError::Terrain(format!(
+                "SDF grid of shape {shape:?} has more than {} voxels; use a coarser resolution",
+                u32::MAX - 1
+            )));
+        }
+        Ok(Self {
+            origin,
+            resolution,
+            shape,
+        })
+    }
+
+    /// Number of nodes.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.shape[0] * self.shape[1] * self.shape[2]
+    }
+
+    /// Whether the lattice has no nodes (never true for a checked spec).
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Linear index of node (i, j, k).
+    #[inline]
+    pub fn index(&self, i: usize, j: usize, k: usize) -> usize {
+        (i * self.shape[1] + j) * self.shape[2] + k
+    }
+
+    /// Node (i, j, k) of a linear index.
+    #[inline]
+    pub fn unravel(&self, index: usize) -> [usize; 3] {
+        let k = index % self.shape[2];
+        let ij = index / self.shape[2];
+        [ij / self.shape[1], ij % self.shape[1], k]
+    }
+
+    /// Position [m] of node (i, j, k).
+    #[inline]
+    pub fn node(&self, i: usize, j: usize, k: usize) -> [f64; 3] {
+        [
+            self.origin[0] + i as f64 * self.resolution,
+            self.origin[1] + j as f64 * self.resolution,
+            self.origin[2] + k as f64 * self.resolution,
+        ]
+    }
+
+    /// Position [m] of the last node, the upper corner of the node box.
+    pub fn upper(&self) -> [f64; 3] {
+        self.node(self.shape[0] - 1, self.shape[1] - 1, self.shape[2] - 1)
+    }
+
+    /// Whether `p` [m] lies in the closed node box, where interpolation applies.
+    #[inline]
+    pub fn contains(&self, p: [f64; 3]) -> bool {
+        (0..3).all(|a| {
+            let g = (p[a] - self.origin[a]) / self.resolution;
+            g >= 0.0 && g <= (self.shape[a] - 1) as f64
+        })
+    }
+}
+
+/// Signed distances [m] stored at the nodes of a [`GridSpec`].
+#[derive(Debug, Clone)]
+pub struct DistanceGrid {
+    spec: GridSpec,
+    values: Vec<f32>,
+    inv_resolution: f64,
+}
+
+impl DistanceGrid {
+    /// Wraps node values (z fastest); every value must be finite.
+    pub fn new(spec: GridSpec, values: Vec<f32>) -> CoreResult<Self> {
+        if values.len() != spec.len() {
+            return Err(CoreError::Terrain(format!(
+                "SDF grid of shape {:?} needs {} values, got {}",
+                spec.shape,
+                spec.len(),
+                values.len()
+            )));
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(CoreError::Terrain(format!(
+                "SDF value at node {:?} is not finite ({})",
+                spec.unravel(i),
+                values[i]
+            )));
+        }
+        Ok(Self {
+            spec,
+            values,
+            inv_resolution: 1.0 / spec.resolution,
+        })
+    }
+
+    /// The lattice.
+    pub fn spec(&self) -> &GridSpec {
+        &self.spec
+    }
+
+    /// Node values [m], z fastest.
+    pub fn values(&self) -> &[f32] {
+        &self.values
+    }
+
+    /// The cell holding `p` [m]: linear index of its lowest corner and the
+    /// fractions (t_x, t_y, t_z) ∈ [0, 1]³, or None outside the node box.
+    #[inline]
+    pub fn locate(&self, p: [f64; 3]) -> Option<(usize, [f64; 3])> {
+        let shape = self.spec.shape;
+        let mut cell = [0usize; 3];
+        let mut t = [0.0f64; 3];
+        for a in 0..3 {
+            let g = (p[a] - self.spec.origin[a]) * self.inv_resolution;
+            let top = (shape[a] - 1) as f64;
+            if !(g >= 0.0 && g <= top) {
+                return None;
+            }
+            // Truncation is floor for g ≥ 0 (and far cheaper than a libm
+            // call); min keeps the last node inside a full cell.
+            let i = (g as usize).min(shape[a] - 2);
+            cell[a] = i;
+            t[a] = g - i as f64;
+        }
+        Some(((cell[0] * shape[1] + cell[1]) * shape[2] + cell[2], t))
+    }
+
+    /// The eight corner values of the cell whose lowest corner is `base`,
+    /// ordered (x, y, z) = 000, 001, 010, 011, 100, 101, 110, 111.
+    #[inline]
+    pub fn corners(&self, base: usize) -> [f32; 8] {
+        let [_, ny, nz] = self.spec.shape;
+        let sx = ny * nz;
+        let v = &self.values;
+        [
+            v[base],
+            v[base + 1],
+            v[base + nz],
+            v[base + nz + 1],
+            v[base + sx],
+            v[base + sx + 1],
+            v[base + sx + nz],
+            v[base + sx + nz + 1],
+        ]
+    }
+
+    /// Trilinear value [m] and gradient from a cell's corners and fractions.
+    #[inline]
+    pub fn interpolate(&self, c: &[f32; 8], t: [f64; 3]) -> (f64, [f64; 3]) {
+        let c = c.map(f64::from);
+        let [tx, ty, tz] = t;
+        // Along z first: the four edge values and their z-slopes.
+        let (s00, s01, s10, s11) = (c[1] - c[0], c[3] - c[2], c[5] - c[4], c[7] - c[6]);
+        let (e00, e01, e10, e11) = (
+            c[0] + s00 * tz,
+            c[2] + s01 * tz,
+            c[4] + s10 * tz,
+            c[6] + s11 * tz,
+        );
+        let f0 = e00 + (e01 - e00) * ty;
+        let f1 = e10 + (e11 - e10) * ty;
+        let d = f0 + (f1 - f0) * tx;
+        let gx = f1 - f0;
+        let gy = (e01 - e00) * (1.0 - tx) + (e11 - e10) * tx;
+        let sz0 = s00 + (s01 - s00) * ty;
+        let sz1 = s10 + (s11 - s10) * ty;
+        let gz = sz0 + (sz1 - sz0) * tx;
+        let k = self.inv_resolution;
+        (d, [gx * k, gy * k, gz * k])
+    }
+
+    /// Trilinear value [m] and its gradient at `p` [m], or None outside the
+    /// node box (the caller decides what outside means, see
+    /// `SignedDistanceField`).
+    #[inline]
+    pub fn trilinear(&self, p: [f64; 3]) -> Option<(f64, [f64; 3])> {
+        let (base, t) = self.locate(p)?;
+        Some(self.interpolate(&self.corners(base), t))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn affine_grid() -> DistanceGrid {
+        let spec = GridSpec::new([-0.1, 0.2, -0.05], 0.01, [4, 5, 6]).unwrap();
+        let mut values = Vec::new();
+        for i in 0..4 {
+            for j in 0..5 {
+                for k in 0..6 {
+                    let p = spec.node(i, j, k);
+                    values.push((0.3 * p[0] - 0.2 * p[1] + 0.9 * p[2] + 0.01) as f32);
+                }
+            }
+        }
+        DistanceGrid::new(spec, values).unwrap()
+    }
+
+    #[test]
+    fn trilinear_reproduces_an_affine_field_and_its_gradient() {
+        let g = affine_grid();
+        for p in [
+            [-0.095, 0.213, -0.031],
+            [-0.07, 0.24, 0.0],
+            [-0.0712, 0.2011, -0.0499],
+        ] {
+            let (d, grad) = g.trilinear(p).unwrap();
+            let exact = 0.3 * p[0] - 0.2 * p[1] + 0.9 * p[2] + 0.01;
+            assert!((d - exact).abs() < 1e-6, "{d} vs {exact}");
+            for (a, e) in grad.iter().zip([0.3, -0.2, 0.9]) {
+                assert!((a - e).abs() < 1e-4, "{grad:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn gradient_matches_finite_differences_of_a_nonlinear_field() {
+        let spec = GridSpec::new([0.0; 3], 0.1, [3, 3, 3]).unwrap();
+        let values = (0..27).map(|i| ((i * 7919) % 13) as f32 * 0.01).collect();
+        let g = DistanceGrid::new(spec, values).unwrap();
+        let e = 1e-6;
+        for p in [[0.037, 0.151, 0.088], [0.123, 0.041, 0.177]] {
+            let (_, grad) = g.trilinear(p).unwrap();
+            for a in 0..3 {
+                let (mut hi, mut lo) = (p, p);
+                hi[a] += e;
+                lo[a] -= e;
+                let fd = (g.trilinear(hi).unwrap().0 - g.trilinear(lo).unwrap().0) / (2.0 * e);
+                assert!((fd - grad[a]).abs() < 1e-6, "axis {a}: {fd} vs {}", grad[a]);
+            }
+        }
+    }
+
+    #[test]
+    fn refuses_bad_specs() {
+        assert!(GridSpec::new([0.0; 3], 0.0, [2, 2, 2]).is_err());
+        assert!(GridSpec::new([f64::NAN, 0.0, 0.0], 0.1, [2, 2, 2]).is_err());
+        assert!(GridSpec::new([0.0; 3], 0.1, [1, 2, 2]).is_err());
+        assert!(GridSpec::new([0.0; 3], 0.1, [70_000, 70_000, 2]).is_err());
+        let spec = GridSpec::new([0.0; 3], 0.1, [2, 2, 2]).unwrap();
+        assert!(DistanceGrid::new(spec, vec![0.0; 7]).is_err());
+        assert!(DistanceGrid::new(spec, vec![f32::NAN; 8]).is_err());
+    }
+}
