@@ -51,12 +51,15 @@ def judgements(spec: str, n: int, seed: int = 0) -> list[Preference]:
     return out
 
 
-def make_store(path: Path, terrain: Terrain, n: int = 30) -> list[Preference]:
+def make_store(path: Path, terrain: Terrain, n: int = 30, bulk: bool = False) -> list[Preference]:
     prefs = judgements(terrain.spec, n)
     with PreferenceStore.open(path, create=True) as store:
         store.add_terrain(terrain)
-        for p in prefs:
-            store.add(p)
+        if bulk:
+            store.add_many(prefs)
+        else:
+            for p in prefs:
+                store.add(p)
     return prefs
 
 
@@ -138,7 +141,7 @@ def test_corrupt_store_is_refused_and_never_overwritten(
     tmp_path: Path, terrain: Terrain, damage: str
 ) -> None:
     path = tmp_path / "prefs.sqlite"
-    make_store(path, terrain, n=300)
+    make_store(path, terrain, n=300, bulk=True)
     data = bytearray(path.read_bytes())
     if damage == "random_bytes":
         data = bytearray(np.random.default_rng(0).integers(0, 256, len(data), dtype=np.uint8))
