@@ -405,7 +405,7 @@ impl Band {
         let slots = &*slots;
         let spec = self.spec;
         let [nx, ny, nz] = spec.shape;
-        let (sx, sy) = (ny * nz, nz);
+        let sx = ny * nz;
         // Upward unit normal of the height field at each band voxel's
         // closest point (none for meshes), for the Newton step below.
         let normals: Vec<[f64; 3]> = match &self.occupancy {
@@ -431,16 +431,10 @@ impl Band {
             let pts = &band.exact_points;
             let (mut best, mut slot) = (dist2(p, pts[own as usize]), own);
             // The nearest seed's closest point is not always the nearest
-            // closest point: where seed regions meet, a face neighbour's seed
-            // may have a better one.
-            let nbrs = [
-                (i > 0).then(|| idx - sx),
-                (i + 1 < nx).then(|| idx + sx),
-                (j > 0).then(|| idx - sy),
-                (j + 1 < ny).then(|| idx + sy),
-                (k > 0).then(|| idx - 1),
-                (k + 1 < nz).then(|| idx + 1),
-            ];
+            // closest point: where seed regions meet, a neighbour's seed may
+            // have a better one. The sweeps passed those along y and z; here
+            // the two x neighbours get their turn.
+            let nbrs = [(i > 0).then(|| idx - sx), (i + 1 < nx).then(|| idx + sx)];
             for n in nbrs.into_iter().flatten() {
                 let s = slots[n];
                 if s != slot && s != NO_SEED {
