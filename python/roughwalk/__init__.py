@@ -15,6 +15,7 @@ from roughwalk.errors import (
 )
 from roughwalk.robots import Robot, load_robot
 from roughwalk.terrain import Terrain, load_terrain
+from roughwalk.trajopt import optimize_motion
 
 __all__ = [
     "__version__",
@@ -28,4 +29,5 @@ __all__ = [
     "load_terrain",
     "Robot",
     "load_robot",
+    "optimize_motion",
 ]

@@ -1,0 +1,64 @@
+"""Single-rigid-body dynamics at collocation samples (Winkler 2018, §IV; Melon 2020, §III-A).
+
+At every sample time t (every ``dt_dynamics`` and T) the base's motion and
+the contact forces must satisfy the Newton–Euler equations
+
+    m c̈ − Σᵢ fᵢ − m g = 0,    I_w ω̇ + ω × I_w ω − Σᵢ (pᵢ − c) × fᵢ = 0,
+
+with I_w = R I_b Rᵀ; rows in [N] and [N·m], as TOWR 1.4's ``GetDynamicViolation``.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import casadi as ca
+
+from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_rows
+from roughwalk.trajopt.robot_model import GRAVITY, SingleRigidBody
+from roughwalk.trajopt.variables import angular_acceleration, angular_velocity, euler_to_rotation
+
+if TYPE_CHECKING:
+    from roughwalk.trajopt.formulation import Formulation
+
+__all__ = ["Dynamics", "dynamics_residual_function"]
+
+
+def dynamics_residual_function(body: SingleRigidBody, n_feet: int = 4) -> ca.Function:
+    """SX function (c, c̈, η, η̇, η̈, feet (3n), forces (3n)) → 6 residuals [N, N·m]."""
+    c, cdd = ca.SX.sym("c", 3), ca.SX.sym("cdd", 3)
+    eta, etad, etadd = ca.SX.sym("eta", 3), ca.SX.sym("etad", 3), ca.SX.sym("etadd", 3)
+    feet, forces = ca.SX.sym("feet", 3 * n_feet), ca.SX.sym("forces", 3 * n_feet)
+    rot = euler_to_rotation(eta)
+    inertia = ca.DM(body.inertia_matrix)
+    i_world = rot @ inertia @ rot.T
+    omega = angular_velocity(eta, etad)
+    omega_dot = angular_acceleration(eta, etad, etadd)
+    f_sum = ca.SX.zeros(3)
+    torque = ca.SX.zeros(3)
+    for i in range(n_feet):
+        f = forces[3 * i : 3 * i + 3]
+        f_sum += f
+        torque += ca.cross(feet[3 * i : 3 * i + 3] - c, f)
+    linear = body.mass * (cdd - ca.DM([0.0, 0.0, -GRAVITY])) - f_sum
+    angular = i_world @ omega_dot + ca.cross(omega, i_world @ omega) - torque
+    return ca.Function(
+        "srbd_residual", [c, cdd, eta, etad, etadd, feet, forces], [ca.vertcat(angular, linear)]
+    )
+
+
+@register("dynamics")
+class Dynamics(Constraint):
+    """Newton–Euler equations of the single rigid body at the dynamics samples."""
+
+    def build(self, nlp: Formulation) -> Rows | None:
+        """Six rows per sample time."""
+        residual = dynamics_residual_function(nlp.body, nlp.n_feet)
+        parts = []
+        for t in nlp.sample_times(nlp.config.dt_dynamics):
+            c, _, cdd = nlp.base_lin.spline.point(t)
+            eta, etad, etadd = nlp.base_ang.spline.point(t)
+            feet = ca.vertcat(*[m.spline.point(t)[0] for m in nlp.feet])
+            forces = ca.vertcat(*[f.spline.point(t)[0] for f in nlp.forces])
+            parts.append((residual(c, cdd, eta, etad, etadd, feet, forces), 0.0, 0.0))
+        return stack_rows(self.name, parts)

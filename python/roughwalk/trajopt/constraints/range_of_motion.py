@@ -1,0 +1,46 @@
+"""Each foot inside a box around its nominal position, in the base frame (Winkler 2018, §V-D).
+
+At every ``dt_range_of_motion`` and T: Rᵀ (pᵢ − c) ∈ nominalᵢ ± max_deviation.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import casadi as ca
+import numpy as np
+
+from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_rows
+from roughwalk.trajopt.variables import euler_to_rotation
+
+if TYPE_CHECKING:
+    from roughwalk.trajopt.formulation import Formulation
+
+__all__ = ["RangeOfMotion"]
+
+
+@register("range_of_motion")
+class RangeOfMotion(Constraint):
+    """The legs' reach as a box per foot [m]."""
+
+    def build(self, nlp: Formulation) -> Rows | None:
+        """Three rows per foot and sample time."""
+        c, eta, foot = ca.SX.sym("c", 3), ca.SX.sym("eta", 3), ca.SX.sym("p", 3)
+        in_base = ca.Function(
+            "foot_in_base", [c, eta, foot], [euler_to_rotation(eta).T @ (foot - c)]
+        )
+        stance = nlp.body.stance
+        dev = np.asarray(nlp.body.max_deviation)
+        parts = []
+        for t in nlp.sample_times(nlp.config.dt_range_of_motion):
+            base = nlp.base_lin.spline.point(t)[0]
+            angles = nlp.base_ang.spline.point(t)[0]
+            for i, motion in enumerate(nlp.feet):
+                parts.append(
+                    (
+                        in_base(base, angles, motion.spline.point(t)[0]),
+                        stance[i] - dev,
+                        stance[i] + dev,
+                    )
+                )
+        return stack_rows(self.name, parts)

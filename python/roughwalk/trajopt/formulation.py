@@ -1,0 +1,372 @@
+"""The NLP, gathered from its parts (TOWR's ``NlpFormulation``).
+
+:class:`Formulation` only gathers: it makes the variable sets (TOWR's order
+and layout: base linear, base angular, foot motions, foot forces, phase
+durations), asks every constraint named in the config for its rows and every
+cost for its term, and assembles them into a CasADi NLP whose parameter
+vector p is the task. The parts read what they need through the methods
+here (spline points, sample times, terrain queries, task symbols).
+
+Terrain heights are B-splines, which CasADi evaluates only in MX, while the
+rest is far cheaper in SX. Parts therefore ask :meth:`Formulation.terrain_at`
+for a point's terrain values and receive placeholder symbols; assembly then
+composes, in MX, the SX function of the query points, the mapped terrain
+function and the SX function of costs and constraints.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from roughwalk.errors import InvalidArgumentError
+from roughwalk.trajopt.constraints import Rows, make_constraint
+from roughwalk.trajopt.costs import CostTerm, make_costs
+from roughwalk.trajopt.gaits import ContactSchedule
+from roughwalk.trajopt.parameters import TrajoptConfig
+from roughwalk.trajopt.robot_model import SingleRigidBody
+from roughwalk.trajopt.task import TASK_SIZE
+from roughwalk.trajopt.terrain_model import TerrainModel
+from roughwalk.trajopt.variables import (
+    BaseAngular,
+    BaseLinear,
+    FootForce,
+    FootMotion,
+    PhaseDurations,
+    VariableSet,
+    base_poly_durations,
+)
+
+__all__ = ["Formulation", "TaskSymbols"]
+
+_ROWS_PER_BLOCK = 6
+
+
+@dataclass(frozen=True)
+class TaskSymbols:
+    """The task's slices of the parameter vector p (see :meth:`ResolvedTask.vector`)."""
+
+    start_position: ca.SX
+    start_euler: ca.SX
+    start_feet: list[ca.SX]
+    goal_xy: ca.SX
+    goal_euler: ca.SX
+    goal_z: ca.SX
+
+    @classmethod
+    def of(cls, p: ca.SX) -> TaskSymbols:
+        """Slice p."""
+        return cls(
+            p[0:3],
+            p[3:6],
+            [p[6 + 3 * f : 9 + 3 * f] for f in range(4)],
+            p[18:20],
+            p[20:23],
+            p[23],
+        )
+
+
+def _balanced_sum(terms: list[ca.SX]) -> ca.SX:
+    """Sum sparse matrices pairwise, so that merging sparsity patterns stays cheap."""
+    while len(terms) > 1:
+        terms = [
+            terms[i] + terms[i + 1] if i + 1 < len(terms) else terms[i]
+            for i in range(0, len(terms), 2)
+        ]
+    return terms[0]
+
+
+class Formulation:
+    """The NLP of one (body, contact schedule, duration, terrain, config).
+
+    Parameters
+    ----------
+    config:
+        Which constraints and costs, discretisation, bounds.
+    body:
+        The single rigid body.
+    schedule:
+        The contact schedule (its total duration is T).
+    terrain:
+        The smooth terrain.
+
+    """
+
+    def __init__(
+        self,
+        config: TrajoptConfig,
+        body: SingleRigidBody,
+        schedule: ContactSchedule,
+        terrain: TerrainModel,
+    ) -> None:
+        self.config = config
+        self.body = body
+        self.schedule = schedule
+        self.terrain = terrain
+        self.total_duration = schedule.total_duration
+        if self.total_duration <= 0:
+            raise InvalidArgumentError(f"duration must be > 0 s, got {self.total_duration}")
+
+        base_durations = base_poly_durations(self.total_duration, config.base_poly_duration)
+        self.base_lin = BaseLinear(base_durations)
+        self.base_ang = BaseAngular(base_durations)
+        self.durations = [
+            PhaseDurations(
+                f, schedule.durations[f], config.phase_duration_bounds, config.optimize_durations
+            )
+            for f in range(schedule.n_feet)
+        ]
+        self.feet = [
+            FootMotion(
+                f, schedule.in_contact_at_start[f], config.foot_polys_per_swing, self.durations[f]
+            )
+            for f in range(schedule.n_feet)
+        ]
+        self.forces = [
+            FootForce(
+                f, schedule.in_contact_at_start[f], config.force_polys_per_stance, self.durations[f]
+            )
+            for f in range(schedule.n_feet)
+        ]
+        # TOWR's order: base linear, base angular, motions, forces, schedules.
+        self.variable_sets: list[VariableSet] = [
+            self.base_lin,
+            self.base_ang,
+            *self.feet,
+            *self.forces,
+            *self.durations,
+        ]
+        self.x = ca.vertcat(*[v.symbols for v in self.variable_sets])
+        self.p = ca.SX.sym("task", TASK_SIZE)
+        self.task = TaskSymbols.of(self.p)
+
+        self._query_keys: dict[str, int] = {}
+        self._query_xy: list[ca.SX] = []
+        self._query_symbols: list[ca.SX] = []
+
+        self.rows: list[Rows] = []
+        for name in config.constraints:
+            rows = make_constraint(name).build(self)
+            if rows is not None and rows.size:
+                self.rows.append(rows)
+        self.costs: list[CostTerm] = [c for c in make_costs(self) if c is not None]
+        self._assemble()
+
+    # ------------------------------------------------------------------ parts' API
+    @property
+    def n_variables(self) -> int:
+        """Number of decision variables."""
+        return int(self.x.numel())
+
+    @property
+    def n_constraints(self) -> int:
+        """Number of constraint rows."""
+        return int(sum(r.size for r in self.rows))
+
+    @property
+    def n_feet(self) -> int:
+        """Number of feet (4)."""
+        return self.schedule.n_feet
+
+    def sample_times(self, dt: float) -> list[float]:
+        """0, dt, 2·dt, ... and T itself [s], without a repeat at T."""
+        t_total = self.total_duration
+        times = list(np.arange(0.0, t_total, dt))
+        if times and t_total - times[-1] < 1e-6:
+            times.pop()
+        return [float(t) for t in times] + [t_total]
+
+    def terrain_at(self, key: str, xy: ca.SX) -> ca.SX:
+        """Terrain (h [m], ∂h/∂x, ∂h/∂y, edge cost) (4, 1) at ``xy`` (2, 1).
+
+        ``key`` names the point, so that parts asking for the same point share one query.
+        """
+        if self.terrain.flat:
+            return ca.SX(ca.DM([self.terrain.flat_height, 0.0, 0.0, 0.0]))
+        if key not in self._query_keys:
+            self._query_keys[key] = len(self._query_xy)
+            self._query_xy.append(ca.SX(xy))
+            self._query_symbols.append(ca.SX.sym(f"terrain_{len(self._query_xy)}", 4))
+        return self._query_symbols[self._query_keys[key]]
+
+    def foothold_terrain(self, foot: int, phase: int) -> ca.SX:
+        """Terrain values at the foothold of ``foot``'s stance ``phase``."""
+        return self.terrain_at(f"foothold/{foot}/{phase}", self.feet[foot].foothold(phase)[:2])
+
+    def stance_phases(self, foot: int) -> list[int]:
+        """Indices of ``foot``'s stance phases."""
+        return [k for k, s in enumerate(self.feet[foot].stance_phases) if s]
+
+    def swing_phases(self, foot: int) -> list[int]:
+        """Indices of ``foot``'s swing phases."""
+        return [k for k, s in enumerate(self.feet[foot].stance_phases) if not s]
+
+    def fixed_foothold(self, foot: int, phase: int) -> bool:
+        """Whether the foothold of stance ``phase`` is the start foothold (fixed by the task)."""
+        return phase == 0 and self.schedule.in_contact_at_start[foot]
+
+    # ------------------------------------------------------------------ assembly
+    def _assemble(self) -> None:
+        """Build the NLP functions: values, and first derivatives row block by row block.
+
+        CasADi's Jacobian of the whole g colours its columns or rows; with
+        optimised durations every dynamics row touches most foot variables, so
+        that takes hundreds of sweeps over the whole graph. Differentiating a
+        few rows at a time in reverse mode costs a few sweeps of their own
+        small graphs instead, and the blocks are stacked into the Jacobian IPOPT
+        gets (``jac_g``). Terrain values enter as extra inputs whose chain rule
+        is applied in MX.
+        """
+        g = ca.vertcat(*[r.expr for r in self.rows]) if self.rows else ca.SX(0, 1)
+        cost_vector = (
+            ca.vertcat(*[ca.SX(c.expr) for c in self.costs]) if self.costs else ca.SX(0, 1)
+        )
+        f = ca.sum1(cost_vector) if self.costs else ca.SX(0)
+        self.lbg = np.concatenate([r.lower for r in self.rows]) if self.rows else np.zeros(0)
+        self.ubg = np.concatenate([r.upper for r in self.rows]) if self.rows else np.zeros(0)
+        self.lbx = np.concatenate([v.lower for v in self.variable_sets])
+        self.ubx = np.concatenate([v.upper for v in self.variable_sets])
+
+        tq = ca.vertcat(*self._query_symbols) if self._query_symbols else ca.SX(0, 1)
+        z = ca.vertcat(self.x, tq)
+        nx = self.n_variables
+        jac_blocks = []
+        for rows in self.rows:
+            for start in range(0, rows.size, _ROWS_PER_BLOCK):
+                chunk = rows.expr[start : min(start + _ROWS_PER_BLOCK, rows.size)]
+                jac_blocks.append(ca.jacobian(chunk, z))
+        jac_z = ca.vertcat(*jac_blocks) if jac_blocks else ca.SX(0, z.numel())
+        grad_z = ca.gradient(f, z)
+        inputs = [self.x, self.p, tq]
+        values = ca.Function("nlp_values", inputs, [f, g, cost_vector])
+        jac = ca.Function("nlp_jac_parts", inputs, [g, jac_z[:, :nx], jac_z[:, nx:]])
+        grad = ca.Function("nlp_grad_parts", inputs, [f, grad_z[:nx], grad_z[nx:]])
+
+        x_mx = ca.MX.sym("x", nx)
+        p_mx = ca.MX.sym("p", TASK_SIZE)
+        if self._query_xy:
+            queries = ca.Function(
+                "terrain_queries", [self.x, self.p], [ca.horzcat(*self._query_xy)]
+            )
+            t_mx = ca.vec(self.terrain.mapped(len(self._query_xy))(queries(x_mx, p_mx)))
+            dt_dx = ca.jacobian(t_mx, x_mx)
+        else:
+            t_mx = ca.MX(0, 1)
+            dt_dx = ca.MX(0, nx)
+        f_mx, g_mx, c_mx = values(x_mx, p_mx, t_mx)
+        g_j, jx, jt = jac(x_mx, p_mx, t_mx)
+        f_g, gx, gt = grad(x_mx, p_mx, t_mx)
+        self.nlp: dict[str, Any] = {"x": x_mx, "p": p_mx, "f": f_mx, "g": g_mx}
+        self.evaluator = ca.Function("evaluate", [x_mx, p_mx], [f_mx, g_mx, c_mx])
+        self.jac_g = ca.Function(
+            "nlp_jac_g", [x_mx, p_mx], [g_j, jx + jt @ dt_dx], ["x", "p"], ["g", "jac_g_x"]
+        )
+        # IPOPT reads dense buffers: a structurally empty objective must still be a number.
+        self.grad_f = ca.Function(
+            "nlp_grad_f",
+            [x_mx, p_mx],
+            [ca.densify(f_g), ca.densify(gx + dt_dx.T @ gt)],
+            ["x", "p"],
+            ["f", "grad_f_x"],
+        )
+        self._mx = (x_mx, p_mx, t_mx, dt_dx, tq, g, f)
+        self._hess_lag: ca.Function | None = None
+
+    @property
+    def hess_lag(self) -> ca.Function:
+        """IPOPT's Hessian of the Lagrangian (upper triangle), built on first use.
+
+        Block by block like the Jacobian: the Hessian of λ_bᵀ g_b for every row
+        block b and of every cost term, summed; terrain values contribute
+        through the chain rule, their own curvature included.
+        """
+        if self._hess_lag is None:
+            self._hess_lag = self._build_hessian()
+        return self._hess_lag
+
+    def _build_hessian(self) -> ca.Function:
+        x_mx, p_mx, t_mx, dt_dx, tq, g, f = self._mx
+        z = ca.vertcat(self.x, tq)
+        nx = self.n_variables
+        ng = int(g.numel())
+        lam_g = ca.SX.sym("lam_g", ng)
+        lam_f = ca.SX.sym("lam_f")
+        blocks = []
+        offset = 0
+        for rows in self.rows:
+            for start in range(0, rows.size, _ROWS_PER_BLOCK):
+                stop = min(start + _ROWS_PER_BLOCK, rows.size)
+                weights = lam_g[offset + start : offset + stop]
+                blocks.append(ca.hessian(ca.dot(weights, rows.expr[start:stop]), z)[0])
+            offset += rows.size
+        for cost in self.costs:
+            blocks.append(lam_f * ca.hessian(ca.SX(cost.expr), z)[0])
+        hess_z = _balanced_sum(blocks) if blocks else ca.SX(z.numel(), z.numel())
+        # ∂L/∂t: how much the Lagrangian feels each terrain value.
+        mu = ca.gradient(lam_f * f + ca.dot(lam_g, g), tq)
+        parts = ca.Function(
+            "nlp_hess_parts",
+            [self.x, self.p, tq, lam_f, lam_g],
+            [hess_z[:nx, :nx], hess_z[:nx, nx:], hess_z[nx:, nx:], mu],
+        )
+        lam_f_mx = ca.MX.sym("lam_f")
+        lam_g_mx = ca.MX.sym("lam_g", ng)
+        h_xx, h_xt, h_tt, mu_mx = parts(x_mx, p_mx, t_mx, lam_f_mx, lam_g_mx)
+        hessian = h_xx
+        if self._query_xy:
+            # Σⱼ μⱼ ∇²ₓ tⱼ(x): the terrain's own curvature, μ held fixed.
+            mu_sym = ca.MX.sym("mu", t_mx.numel())
+            curvature = ca.Function(
+                "terrain_curvature",
+                [x_mx, p_mx, mu_sym],
+                [ca.hessian(ca.dot(mu_sym, t_mx), x_mx)[0]],
+            )
+            cross = h_xt @ dt_dx
+            hessian = (
+                hessian + cross + cross.T + dt_dx.T @ h_tt @ dt_dx + curvature(x_mx, p_mx, mu_mx)
+            )
+        return ca.Function(
+            "nlp_hess_l",
+            [x_mx, p_mx, lam_f_mx, lam_g_mx],
+            [ca.triu(hessian)],
+            ["x", "p", "lam_f", "lam_g"],
+            ["hess_gamma_x_x"],
+        )
+
+    # ------------------------------------------------------------------ numbers
+    def split(self, x: ArrayLike) -> dict[str, NDArray[np.float64]]:
+        """A solution vector cut into its variable sets, by name."""
+        values = np.asarray(x, dtype=float).ravel()
+        out, start = {}, 0
+        for v in self.variable_sets:
+            out[v.name] = values[start : start + v.size]
+            start += v.size
+        return out
+
+    def join(self, parts: Mapping[str, ArrayLike]) -> NDArray[np.float64]:
+        """A solution vector from per-set values (every set must be given)."""
+        missing = [v.name for v in self.variable_sets if v.name not in parts]
+        if missing:
+            raise InvalidArgumentError(f"initial guess lacks the variable sets {missing}")
+        chunks = []
+        for v in self.variable_sets:
+            chunk = np.asarray(parts[v.name], dtype=float).ravel()
+            if chunk.size != v.size:
+                raise InvalidArgumentError(
+                    f"initial guess for '{v.name}' has {chunk.size} values, expected {v.size}"
+                )
+            chunks.append(chunk)
+        return np.concatenate(chunks) if chunks else np.zeros(0)
+
+    def row_slices(self) -> dict[str, slice]:
+        """Where each constraint's rows sit in g."""
+        out, start = {}, 0
+        for r in self.rows:
+            out[r.name] = slice(start, start + r.size)
+            start += r.size
+        return out

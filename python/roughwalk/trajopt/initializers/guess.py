@@ -1,0 +1,120 @@
+"""Helpers shared by initial guesses: node times and base poses along a straight line."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roughwalk.trajopt.formulation import Formulation
+from roughwalk.trajopt.task import ResolvedTask, nominal_feet
+from roughwalk.trajopt.variables import NodeVariableSet
+
+__all__ = ["node_times", "straight_base", "feet_guess", "forces_guess", "pack_guess"]
+
+
+def node_times(
+    nodes: NodeVariableSet, durations: list[float] | NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Times [s] of a spline's nodes for numeric polynomial ``durations``."""
+    return np.concatenate([[0.0], np.cumsum(np.asarray(durations, dtype=float))])
+
+
+def poly_durations(
+    nlp: Formulation, foot: int, phase_durations: NDArray[np.float64], force: bool
+) -> list[float]:
+    """Numeric polynomial durations [s] of a foot's motion (or force) spline."""
+    nodes = nlp.forces[foot] if force else nlp.feet[foot]
+    return [phase_durations[p.phase] / p.polys_in_phase for p in nodes.polys]
+
+
+def straight_base(
+    nlp: Formulation, task: ResolvedTask, times: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """CoM positions (n, 3) and Euler angles (n, 3) on the straight line from start to goal.
+
+    The height follows the terrain under the nominal feet at each pose, so a
+    guess over a pallet climbs it with the feet.
+    """
+    s = np.clip(np.asarray(times) / nlp.total_duration, 0.0, 1.0)[:, None]
+    start_xy = task.base_position[:2]
+    xy = start_xy + s * (task.goal_xy - start_xy)
+    yaw = task.base_euler[2] + s[:, 0] * (task.goal_euler[2] - task.base_euler[2])
+    z = np.array(
+        [
+            nominal_feet(nlp.body, nlp.terrain, float(p[0]), float(p[1]), float(a))[1]
+            for p, a in zip(xy, yaw, strict=True)
+        ]
+    )
+    z[0] = task.base_position[2]
+    positions = np.column_stack([xy, z])
+    euler = np.column_stack([np.zeros_like(yaw), np.zeros_like(yaw), yaw])
+    return positions, euler
+
+
+def finite_difference(
+    values: NDArray[np.float64], times: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Velocities at nodes from values at node times (zero at both ends: start and goal at rest)."""
+    vel = np.gradient(values, times, axis=0) if len(times) > 2 else np.zeros_like(values)
+    vel[0] = 0.0
+    vel[-1] = 0.0
+    return vel
+
+
+def feet_guess(
+    nlp: Formulation,
+    task: ResolvedTask,
+    foot: int,
+    phase_durations: NDArray[np.float64],
+    footholds: dict[int, NDArray[np.float64]],
+) -> NDArray[np.float64]:
+    """Foot ``foot``'s motion variables from its stance ``footholds`` (phase → (3,) [m]).
+
+    Swing nodes go on the straight line between the swing's footholds, the
+    apex ``swing_clearance`` above the higher one, moving at the step's mean
+    horizontal velocity.
+    """
+    motion = nlp.feet[foot]
+    n_nodes = motion.n_nodes
+    pos = np.zeros((n_nodes, 3))
+    vel = np.zeros((n_nodes, 3))
+    for phase, stance in enumerate(motion.stance_phases):
+        nodes = motion.phase_nodes(phase)
+        if stance:
+            pos[nodes[0]] = pos[nodes[-1]] = footholds[phase]
+            continue
+        before = footholds.get(phase - 1, footholds.get(phase + 1))
+        after = footholds.get(phase + 1, before)
+        assert before is not None and after is not None
+        n = len(nodes) - 1
+        for j, node in enumerate(nodes[1:-1], start=1):
+            frac = j / n
+            pos[node] = before + frac * (after - before)
+            lift = np.sin(np.pi * frac)
+            pos[node, 2] = max(before[2], after[2]) * lift + pos[node, 2] * (1 - lift)
+            pos[node, 2] += nlp.config.swing_clearance * lift
+            vel[node, :2] = (after[:2] - before[:2]) / phase_durations[phase]
+    return motion.pack(pos, vel)
+
+
+def forces_guess(
+    nlp: Formulation,
+    foot: int,
+    phase_durations: NDArray[np.float64],
+    schedule_durations: list[NDArray[np.float64]],
+) -> NDArray[np.float64]:
+    """Foot ``foot``'s force variables: the weight shared by the feet in stance at each node."""
+    force = nlp.forces[foot]
+    times = node_times(force, poly_durations(nlp, foot, phase_durations, force=True))
+    schedule = nlp.schedule.with_durations(schedule_durations)
+    count = sum(schedule.in_contact(f, times).astype(float) for f in range(nlp.n_feet))
+    mine = schedule.in_contact(foot, times)
+    pos = np.zeros((force.n_nodes, 3))
+    pos[:, 2] = np.where(mine, nlp.body.weight / np.maximum(count, 1.0), 0.0)
+    # Nodes at the ends of a stance phase touch the swing: their force is held at zero.
+    return force.pack(pos, np.zeros_like(pos))
+
+
+def pack_guess(nlp: Formulation, parts: dict[str, NDArray[np.float64]]) -> NDArray[np.float64]:
+    """The full variable vector from per-set values."""
+    return nlp.join(parts)

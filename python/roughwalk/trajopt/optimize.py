@@ -1,0 +1,375 @@
+"""``optimize_motion``: from a robot, a terrain and a task to an optimised motion.
+
+The NLP's structure depends on the body, the contact schedule, the duration,
+the terrain and the configuration, not on the task: a :class:`TrajoptProblem`
+is built once for them and solves any number of tasks, and
+:func:`optimize_motion` keeps the last few problems it built so that repeated
+calls reuse them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from collections import OrderedDict
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roughwalk.config import override, to_dict
+from roughwalk.errors import InvalidArgumentError
+from roughwalk.terrain import Terrain, load_terrain
+from roughwalk.trajopt.formulation import Formulation
+from roughwalk.trajopt.gaits import ContactSchedule, make_gait
+from roughwalk.trajopt.initializers import Initializer, make_initializer
+from roughwalk.trajopt.parameters import TrajoptConfig, melon_config
+from roughwalk.trajopt.result import Splines, TrajoptResult
+from roughwalk.trajopt.robot_model import SingleRigidBody, rigid_body_model
+from roughwalk.trajopt.solver import IterationInfo, TrajoptSolver, TrajoptStatus, violation
+from roughwalk.trajopt.task import Task, resolve, stance_problems
+from roughwalk.trajopt.terrain_model import TerrainModel
+from roughwalk.trajopt.variables import NumericSpline
+
+__all__ = ["TrajoptProblem", "optimize_motion", "clear_cache"]
+
+_MIN_FIXED_PHASE = 0.05  # [s] shorter fixed phases are refused as a duration too short
+_CACHE_SIZE = 4
+_problems: OrderedDict[tuple[Any, ...], TrajoptProblem] = OrderedDict()
+_terrains: OrderedDict[tuple[Any, ...], TerrainModel] = OrderedDict()
+
+_MESSAGES = {
+    TrajoptStatus.EXACT: "converged",
+    TrajoptStatus.APPROXIMATE: "converged to IPOPT's acceptable tolerance",
+    TrajoptStatus.ITERATION_LIMIT: "stopped at the iteration limit before converging",
+    TrajoptStatus.TIMEOUT: "stopped at the time limit before converging",
+    TrajoptStatus.CANCELLED: "stopped by the iteration callback",
+    TrajoptStatus.INFEASIBLE: "IPOPT found the constraints locally infeasible",
+    TrajoptStatus.FAILED: "IPOPT failed",
+}
+
+
+class TrajoptProblem:
+    """One NLP and its solver, built once, solved for any task.
+
+    Parameters
+    ----------
+    body:
+        The single rigid body.
+    terrain:
+        The smooth terrain.
+    schedule:
+        The contact schedule (fixes the duration).
+    config:
+        The configuration.
+
+    """
+
+    def __init__(
+        self,
+        body: SingleRigidBody,
+        terrain: TerrainModel,
+        schedule: ContactSchedule,
+        config: TrajoptConfig,
+    ) -> None:
+        start = time.perf_counter()
+        self.body = body
+        self.terrain = terrain
+        self.schedule = schedule
+        self.config = config
+        self.formulation = Formulation(config, body, schedule, terrain)
+        self.solver = TrajoptSolver(self.formulation, config.solver)
+        self.build_time_s = time.perf_counter() - start
+        self._build_pending = True
+
+    @property
+    def n_variables(self) -> int:
+        """Number of decision variables."""
+        return self.formulation.n_variables
+
+    def solve(
+        self,
+        task: Task,
+        initializer: Initializer,
+        *,
+        max_iter: int | None = None,
+        time_limit_s: float | None = None,
+        callback: Callable[[IterationInfo], bool | None] | None = None,
+        warm_start: TrajoptResult | NDArray[np.float64] | None = None,
+        extra_time_s: float = 0.0,
+    ) -> TrajoptResult:
+        """Solve ``task`` from ``initializer``'s guess (or the ``warm_start`` solution).
+
+        The first solve's time includes building the problem; ``extra_time_s``
+        [s] adds time spent before (loading, checks).
+        """
+        nlp = self.formulation
+        resolved = initializer.adjust_task(resolve(task, self.body, self.terrain))
+        if warm_start is None:
+            x0 = initializer.guess(nlp, resolved)
+        else:
+            x0 = np.asarray(warm_start.x if isinstance(warm_start, TrajoptResult) else warm_start)
+            if x0 is None or x0.size != nlp.n_variables:
+                raise InvalidArgumentError(
+                    f"warm start has {getattr(x0, 'size', 0)} values; "
+                    f"this NLP has {nlp.n_variables}"
+                )
+        build = self.build_time_s if self._build_pending else 0.0
+        self._build_pending = False
+        outcome = self.solver.solve(
+            resolved.vector(), x0, max_iter=max_iter, time_limit_s=time_limit_s, callback=callback
+        )
+        return self._result(task, outcome, build, extra_time_s)
+
+    def _result(self, task: Task, outcome: Any, build: float, extra: float) -> TrajoptResult:
+        nlp = self.formulation
+        viol = violation(outcome.g, nlp.lbg, nlp.ubg)
+        bound_viol = violation(outcome.x, nlp.lbx, nlp.ubx)
+        per_row = {
+            name: float(viol[s].max()) if viol[s].size else 0.0
+            for name, s in nlp.row_slices().items()
+        }
+        parts = nlp.split(outcome.x)
+        durations = [d.unpack(parts[d.name]) for d in nlp.durations]
+        schedule = self.schedule.with_durations(durations)
+        splines = _splines(nlp, parts, durations)
+        times = np.linspace(0.0, schedule.total_duration, 400)
+        forces = np.stack([f.evaluate(times)[0] for f in splines.forces], axis=1)
+        max_violation = float(max(viol.max(initial=0.0), bound_viol.max(initial=0.0)))
+        if not np.all(np.isfinite(outcome.x)):
+            max_violation = float("inf")
+        message = _MESSAGES.get(outcome.status, outcome.return_status)
+        if not outcome.status.solved and per_row:
+            worst = max(per_row, key=lambda k: per_row[k])
+            message += f"; worst constraint '{worst}' violated by {per_row[worst]:.3g}"
+        return TrajoptResult(
+            status=outcome.status,
+            message=message,
+            iterations=outcome.iterations,
+            solve_time_s=outcome.solve_time_s + build + extra,
+            build_time_s=build,
+            objective=outcome.objective,
+            max_violation=max_violation,
+            max_force_n=float(np.linalg.norm(forces, axis=2).max()),
+            n_variables=nlp.n_variables,
+            n_constraints=nlp.n_constraints,
+            task=task,
+            config=to_dict(self.config),
+            body=self.body,
+            schedule=schedule,
+            splines=splines,
+            costs={c.name: float(v) for c, v in zip(nlp.costs, outcome.costs, strict=True)},
+            violations=per_row,
+            return_status=outcome.return_status,
+            history=outcome.history,
+            x=outcome.x,
+            terrain=self.terrain.name,
+        )
+
+
+def _splines(
+    nlp: Formulation, parts: dict[str, NDArray[np.float64]], durations: list[NDArray[np.float64]]
+) -> Splines:
+    def nodes(v: Any, poly_durations: list[float]) -> NumericSpline:
+        pos, vel = v.unpack(parts[v.name])
+        return NumericSpline(pos, vel, poly_durations)
+
+    def phase_polys(v: Any, foot: int) -> list[float]:
+        return [durations[foot][p.phase] / p.polys_in_phase for p in v.polys]
+
+    return Splines(
+        nodes(nlp.base_lin, nlp.base_lin.durations),
+        nodes(nlp.base_ang, nlp.base_ang.durations),
+        [nodes(m, phase_polys(m, f)) for f, m in enumerate(nlp.feet)],
+        [nodes(m, phase_polys(m, f)) for f, m in enumerate(nlp.forces)],
+    )
+
+
+def _terrain_key(terrain: Terrain) -> tuple[Any, ...]:
+    digest = hashlib.blake2b(
+        np.ascontiguousarray(terrain.heights).tobytes(), digest_size=16
+    ).hexdigest()
+    return (terrain.spec, terrain.shape, terrain.x0, terrain.y0, terrain.dx, terrain.dy, digest)
+
+
+def _cached(
+    cache: OrderedDict[tuple[Any, ...], Any], key: tuple[Any, ...], make: Callable[[], Any]
+) -> tuple[Any, bool]:
+    if key in cache:
+        cache.move_to_end(key)
+        return cache[key], True
+    value = make()
+    cache[key] = value
+    while len(cache) > _CACHE_SIZE:
+        cache.popitem(last=False)
+    return value, False
+
+
+def clear_cache() -> None:
+    """Forget every built problem and terrain model."""
+    _problems.clear()
+    _terrains.clear()
+
+
+def _configure(config: TrajoptConfig | None, overrides: Mapping[str, Any]) -> TrajoptConfig:
+    cfg = config or melon_config()
+    changes: dict[str, Any] = {}
+    for key, value in overrides.items():
+        if key == "fixed_durations":
+            changes["optimize_durations"] = not value
+        else:
+            changes[key.replace("__", ".")] = value
+    return override(cfg, changes) if changes else cfg
+
+
+def _invalid(
+    task: Task | None,
+    cfg: TrajoptConfig,
+    message: str,
+    robot: str | None,
+    terrain: str | None,
+    elapsed: float,
+) -> TrajoptResult:
+    return TrajoptResult(
+        status=TrajoptStatus.INVALID_INPUT,
+        message=message,
+        solve_time_s=elapsed,
+        task=task,
+        config=to_dict(cfg),
+        robot=robot,
+        terrain=terrain,
+    )
+
+
+def _schedule_problems(schedule: ContactSchedule, cfg: TrajoptConfig) -> list[str]:
+    out = []
+    lo = cfg.phase_duration_bounds[0]
+    for foot, durations in enumerate(schedule.durations):
+        if cfg.optimize_durations and len(durations) * lo > schedule.total_duration + 1e-9:
+            out.append(
+                f"duration {schedule.total_duration:g} s is too short for {schedule.steps} steps: "
+                f"foot {foot}'s {len(durations)} phases need at least {len(durations) * lo:g} s "
+                f"at {lo:g} s each"
+            )
+            break
+        if not cfg.optimize_durations and min(durations) < _MIN_FIXED_PHASE:
+            out.append(
+                f"duration {schedule.total_duration:g} s is too short for {schedule.steps} steps: "
+                f"foot {foot}'s shortest phase would last {min(durations):.3f} s "
+                f"(at least {_MIN_FIXED_PHASE} s)"
+            )
+            break
+    return out
+
+
+def optimize_motion(
+    robot: Any,
+    terrain: Terrain | str,
+    task: Any,
+    *,
+    config: TrajoptConfig | None = None,
+    max_iter: int | None = None,
+    time_limit_s: float | None = None,
+    callback: Callable[[IterationInfo], bool | None] | None = None,
+    warm_start: TrajoptResult | NDArray[np.float64] | None = None,
+    **overrides: Any,
+) -> TrajoptResult:
+    """Optimise a motion of ``robot`` over ``terrain`` for ``task`` (Melon 2020, §III).
+
+    Parameters
+    ----------
+    robot:
+        A :class:`~roughwalk.robots.Robot` or its name; may be None with
+        ``body_model="towr_anymal"``.
+    terrain:
+        A :class:`~roughwalk.terrain.Terrain` or a terrain spec.
+    task:
+        A :class:`Task`, {"start": (x, y, yaw), "goal": (x, y, yaw)} or a
+        (start, goal) pair, poses in [m], [m], [rad].
+    config:
+        The configuration (default :func:`melon_config`).
+    max_iter, time_limit_s:
+        Per-solve limits (default: the config's ``solver`` ones) [-, s].
+    callback:
+        Called at every iteration with an :class:`IterationInfo`; returning
+        True stops the solve (status CANCELLED).
+    warm_start:
+        A previous result (or solution vector) of the same problem to start from.
+    **overrides:
+        Config fields to change: ``gait="trot"``, ``steps=14``,
+        ``duration=3.5``, ``fixed_durations=True``, ``init="heuristic"``,
+        nested ones with "__" (``costs__force__weight=0``).
+
+    Returns
+    -------
+    TrajoptResult
+        Its status says whether it solved; a malformed task (NaN, off the
+        terrain, inside an obstacle, a duration too short for the steps) gives
+        status INVALID_INPUT instead of an exception.
+
+    """
+    start = time.perf_counter()
+    cfg = _configure(config, overrides)
+    if isinstance(robot, str):
+        from roughwalk.robots import load_robot
+
+        robot = load_robot(robot)
+    robot_name = getattr(robot, "name", None) if robot is not None else cfg.body_model
+    terrain_obj = load_terrain(terrain) if isinstance(terrain, str) else terrain
+    the_task = Task.from_any(task)
+    body = rigid_body_model(cfg.body_model, robot)
+    problems = the_task.problems()
+    if problems:
+        return _invalid(
+            the_task,
+            cfg,
+            "; ".join(problems),
+            robot_name,
+            terrain_obj.spec,
+            time.perf_counter() - start,
+        )
+    terrain_model, _ = _cached(
+        _terrains,
+        (_terrain_key(terrain_obj), cfg.terrain, cfg.costs.step_edge_sigma),
+        lambda: TerrainModel(terrain_obj, cfg.terrain, cfg.costs.step_edge_sigma),
+    )
+    initializer = make_initializer(cfg.init)
+    schedule = initializer.schedule(make_gait(cfg.gait, cfg.steps, cfg.duration))
+    problems = _schedule_problems(schedule, cfg)
+    problems += stance_problems(body, terrain_model, the_task.start, "start")
+    problems += stance_problems(body, terrain_model, the_task.goal, "goal")
+    if problems:
+        return _invalid(
+            the_task,
+            cfg,
+            "; ".join(problems),
+            robot_name,
+            terrain_obj.spec,
+            time.perf_counter() - start,
+        )
+    key = (
+        body,
+        _terrain_key(terrain_obj),
+        schedule.durations,
+        schedule.in_contact_at_start,
+        schedule.name,
+        cfg.structure_key(),
+    )
+    problem, _ = _cached(_problems, key, lambda: TrajoptProblem(body, terrain_model, schedule, cfg))
+    elapsed = (
+        time.perf_counter() - start - (problem.build_time_s if problem._build_pending else 0.0)
+    )
+    result = problem.solve(
+        the_task,
+        initializer,
+        max_iter=max_iter if max_iter is not None else cfg.solver.max_iter,
+        time_limit_s=time_limit_s if time_limit_s is not None else cfg.solver.time_limit_s,
+        callback=callback,
+        warm_start=warm_start,
+        extra_time_s=max(elapsed, 0.0),
+    )
+    result.config = to_dict(cfg)
+    result.robot = robot_name
+    result.terrain = terrain_obj.spec
+    return result

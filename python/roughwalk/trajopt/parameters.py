@@ -1,0 +1,354 @@
+"""The trajectory optimiser's configuration: frozen dataclasses whose fields state their units.
+
+Two presets cover the papers:
+
+* :func:`melon_config` (the default): TOWR's constraints plus Melon et al.'s
+  additions (base above the feet, swing height and apex) and analytic costs
+  (Melon 2020, §III-A);
+* :func:`towr_config`: TOWR 1.4's default problem, a pure feasibility problem
+  with its constraints only and its ANYmal parameters, so that timings can be
+  compared with TOWR's on the identical problem.
+
+Change any field with :func:`roughwalk.config.override` and dotted keys
+(``costs.force.weight=0``, ``solver.hessian=limited-memory``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+from roughwalk.errors import ConfigError
+
+__all__ = [
+    "IntegralCost",
+    "CostWeights",
+    "TerrainModelConfig",
+    "SolverOptions",
+    "TrajoptConfig",
+    "TOWR_CONSTRAINTS",
+    "MELON_CONSTRAINTS",
+    "melon_config",
+    "towr_config",
+]
+
+TOWR_CONSTRAINTS: tuple[str, ...] = (
+    "terrain",
+    "dynamics",
+    "base_acceleration",
+    "range_of_motion",
+    "force",
+    "total_duration",
+    "initial_state",
+    "goal_state",
+)
+"""TOWR 1.4's default constraint set (``Parameters()`` plus the start and goal bounds)."""
+
+MELON_CONSTRAINTS: tuple[str, ...] = (
+    *TOWR_CONSTRAINTS,
+    "base_above_feet",
+    "swing_height",
+    "swing_apex",
+)
+"""TOWR's constraints plus Melon et al.'s base-above-feet and swing-height ones and a swing apex."""
+
+
+@dataclass(frozen=True)
+class IntegralCost:
+    """Weights of one of Melon et al.'s integral costs (Eq. 1).
+
+    J = ω ∫₀ᵀ ((x(t) − x_ref)² + ω_d ẋ(t)²) dt. A weight of 0 removes the cost.
+
+    Attributes
+    ----------
+    weight:
+        ω: how much the cost counts in the objective. Larger values make the
+        motion smoother in this quantity at the price of more iterations.
+    derivative_weight:
+        ω_d [s²]: weight of the squared time derivative relative to the value;
+        larger values penalise short, sharp changes.
+
+    """
+
+    weight: float = 0.0
+    derivative_weight: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (self.weight >= 0 and self.derivative_weight >= 0):
+            raise ConfigError(
+                f"cost weights must be ≥ 0, got weight={self.weight}, "
+                f"derivative_weight={self.derivative_weight}"
+            )
+
+
+@dataclass(frozen=True)
+class CostWeights:
+    """Melon et al.'s analytic costs (§III-A); forces enter divided by m·g.
+
+    Attributes
+    ----------
+    base_vertical_velocity:
+        On ż [m/s] and z̈: damps bouncing of the base.
+    base_angular_velocity:
+        On the Euler rates (roll, pitch, yaw) [rad/s] and their derivatives:
+        damps rolling and pitching, which the tracking controller handles badly.
+    force:
+        On every contact force component f/(m·g) and its derivative: lowers
+        peak forces and their rates.
+    normal_force:
+        On (f·n − f_ref)/(m·g) during stance, with f_ref = m·g / (feet in
+        stance): keeps the weight shared evenly.
+    step_edge:
+        Weight of the Gaussian step-edge cost exp(−x_s²/2σ²) per foothold.
+    step_edge_sigma:
+        σ [m] of that Gaussian: how far from an edge a foothold is still pushed away.
+    swing_height:
+        Weight [1/m²] on (apex height − mean height of the two footholds)²:
+        keeps steps low (the swing-height constraint keeps them high enough).
+
+    """
+
+    base_vertical_velocity: IntegralCost = field(default_factory=lambda: IntegralCost(1.0, 0.01))
+    base_angular_velocity: IntegralCost = field(default_factory=lambda: IntegralCost(0.5, 0.01))
+    force: IntegralCost = field(default_factory=lambda: IntegralCost(0.05, 0.001))
+    normal_force: IntegralCost = field(default_factory=lambda: IntegralCost(0.05, 0.0))
+    step_edge: float = 1.0
+    step_edge_sigma: float = 0.05
+    swing_height: float = 5.0
+
+    def __post_init__(self) -> None:
+        if self.step_edge < 0 or self.swing_height < 0:
+            raise ConfigError(
+                f"cost weights must be ≥ 0, got step_edge={self.step_edge}, "
+                f"swing_height={self.swing_height}"
+            )
+        if not self.step_edge_sigma > 0:
+            raise ConfigError(f"step_edge_sigma must be > 0 m, got {self.step_edge_sigma}")
+
+    @classmethod
+    def none(cls) -> CostWeights:
+        """No cost at all: TOWR's pure feasibility problem."""
+        zero = IntegralCost(0.0, 0.0)
+        return cls(zero, zero, zero, zero, 0.0, 0.05, 0.0)
+
+
+@dataclass(frozen=True)
+class TerrainModelConfig:
+    """How the terrain becomes a smooth, differentiable surface for the NLP.
+
+    Attributes
+    ----------
+    resolution:
+        Spacing [m] of the B-spline's control points. Finer follows the
+        terrain more closely; coarser smooths steps into wider ramps.
+    smoothing:
+        σ [m] of the Gaussian blur applied before fitting; 0 keeps the raw
+        resampled heights (steps then ring less than they would with an
+        interpolating spline, since the control points are the heights).
+    edge_slope:
+        Slope (rise over run) above which a cell counts as part of an edge
+        for the step-edge cost.
+
+    """
+
+    resolution: float = 0.02
+    smoothing: float = 0.01
+    edge_slope: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not self.resolution > 0:
+            raise ConfigError(f"terrain.resolution must be > 0 m, got {self.resolution}")
+        if self.smoothing < 0:
+            raise ConfigError(f"terrain.smoothing must be ≥ 0 m, got {self.smoothing}")
+        if not self.edge_slope > 0:
+            raise ConfigError(f"terrain.edge_slope must be > 0, got {self.edge_slope}")
+
+
+@dataclass(frozen=True)
+class SolverOptions:
+    """IPOPT's settings and the solve's termination conditions.
+
+    Attributes
+    ----------
+    max_iter:
+        Iteration limit per solve; reaching it gives status ITERATION_LIMIT.
+    time_limit_s:
+        Wall-time limit [s] per solve (TOWR's ROS app uses 40 s of CPU time).
+    hessian:
+        "exact" (second derivatives), "limited-memory" (L-BFGS, as TOWR's
+        ifopt) or "auto": exact when the NLP has costs and fixed phase
+        durations, L-BFGS otherwise. L-BFGS solves TOWR's feasibility problems
+        in fewer, cheaper iterations; with costs it converges slowly, and with
+        optimised durations the exact Hessian is dense and slow to build.
+    tol:
+        IPOPT's convergence tolerance on the scaled NLP error.
+    acceptable_tol:
+        IPOPT's "acceptable" tolerance; a solve stuck there for a few
+        iterations ends with status APPROXIMATE.
+    constr_viol_tol:
+        Largest constraint violation a converged solution may have (in the
+        constraints' own units: m, m/s², N, ...).
+    linear_solver:
+        IPOPT's linear solver ("mumps" ships with CasADi).
+    print_level:
+        IPOPT's verbosity (0 silent, 5 per iteration).
+
+    """
+
+    max_iter: int = 3000
+    time_limit_s: float = 40.0
+    hessian: str = "auto"
+    tol: float = 1e-6
+    acceptable_tol: float = 1e-4
+    constr_viol_tol: float = 1e-4
+    linear_solver: str = "mumps"
+    print_level: int = 0
+
+    def __post_init__(self) -> None:
+        if self.hessian not in ("auto", "exact", "limited-memory"):
+            raise ConfigError(
+                f"solver.hessian must be 'auto', 'exact' or 'limited-memory', got {self.hessian!r}"
+            )
+        if self.max_iter < 0:
+            raise ConfigError(f"solver.max_iter must be ≥ 0, got {self.max_iter}")
+        if not self.time_limit_s > 0:
+            raise ConfigError(f"solver.time_limit_s must be > 0 s, got {self.time_limit_s}")
+
+
+@dataclass(frozen=True)
+class TrajoptConfig:
+    """Everything that defines the NLP and its solve (TOWR's ``Parameters`` and more).
+
+    Attributes
+    ----------
+    gait:
+        Contact schedule: "walk", "trot", "pace", "bound" or "gallop".
+    steps:
+        Number of swings of all feet together (16 is TOWR's walk, 14 Melon's trot).
+    duration:
+        Total duration T [s]. Longer gives slower, easier motions.
+    optimize_durations:
+        Optimise the phase durations (adds one variable per phase and foot
+        but the last): more freedom, but every sample may fall in any
+        polynomial, which makes the NLP dense — slower iterations and, with
+        costs, slow convergence. Off by default, as in TOWR; Melon et al.
+        found fixed durations more reliable too (Fig. 8).
+    phase_duration_bounds:
+        (min, max) [s] of an optimised phase (TOWR's 0.2–1.0 s).
+    body_model:
+        "robot" (single rigid body from the Robot's model) or "towr_anymal"
+        (TOWR's published ANYmal values).
+    base_poly_duration:
+        Duration [s] of one polynomial of the base splines; shorter means more
+        variables and a finer dynamics check.
+    foot_polys_per_swing:
+        Polynomials per swing phase of a foot's motion (2: lift and land).
+    force_polys_per_stance:
+        Polynomials per stance phase of a foot's force (3).
+    dt_dynamics:
+        Interval [s] between the samples where the dynamics are enforced.
+    dt_range_of_motion:
+        Interval [s] between the samples of the range-of-motion and
+        base-above-feet constraints.
+    constraints:
+        Names of the constraints to use (see :mod:`roughwalk.trajopt.constraints`).
+    costs:
+        Cost weights (:class:`CostWeights`).
+    swing_clearance:
+        Height [m] of a swing's apex above both of its footholds (Melon's
+        swing-height constraint).
+    base_clearance:
+        Least height of the base above every foot (Melon's base-above-feet
+        constraint), as a fraction of the nominal base height.
+    init:
+        Initial guess: "heuristic", "footsteps:PLAN.json" or "learned".
+    terrain:
+        Terrain smoothing (:class:`TerrainModelConfig`).
+    solver:
+        IPOPT settings and limits (:class:`SolverOptions`).
+    sample_rate_hz:
+        Rate [Hz] at which results sample the trajectories for JSON output.
+
+    """
+
+    gait: str = "walk"
+    steps: int = 16
+    duration: float = 5.5
+    optimize_durations: bool = False
+    phase_duration_bounds: tuple[float, float] = (0.2, 1.0)
+    body_model: str = "robot"
+    base_poly_duration: float = 0.1
+    foot_polys_per_swing: int = 2
+    force_polys_per_stance: int = 3
+    dt_dynamics: float = 0.1
+    dt_range_of_motion: float = 0.08
+    constraints: tuple[str, ...] = MELON_CONSTRAINTS
+    costs: CostWeights = field(default_factory=CostWeights)
+    swing_clearance: float = 0.08
+    base_clearance: float = 0.7
+    init: str = "heuristic"
+    terrain: TerrainModelConfig = field(default_factory=TerrainModelConfig)
+    solver: SolverOptions = field(default_factory=SolverOptions)
+    sample_rate_hz: float = 100.0
+
+    def __post_init__(self) -> None:
+        lo, hi = self.phase_duration_bounds
+        if not 0 < lo < hi:
+            raise ConfigError(
+                f"phase_duration_bounds must be 0 < min < max [s], got {self.phase_duration_bounds}"
+            )
+        for name in ("base_poly_duration", "dt_dynamics", "dt_range_of_motion", "sample_rate_hz"):
+            if not getattr(self, name) > 0:
+                raise ConfigError(f"{name} must be > 0, got {getattr(self, name)}")
+        for name in ("foot_polys_per_swing", "force_polys_per_stance"):
+            if getattr(self, name) < 1:
+                raise ConfigError(f"{name} must be ≥ 1, got {getattr(self, name)}")
+        if self.swing_clearance < 0 or self.base_clearance < 0:
+            raise ConfigError(
+                f"swing_clearance and base_clearance must be ≥ 0 m, got "
+                f"{self.swing_clearance}, {self.base_clearance}"
+            )
+        if len(set(self.constraints)) != len(self.constraints):
+            raise ConfigError(f"constraints are listed twice: {self.constraints}")
+
+    def structure_key(self) -> tuple[object, ...]:
+        """The fields that change the NLP's structure (not the task, guess or solve limits)."""
+        return tuple(
+            getattr(self, f)
+            for f in (
+                "optimize_durations",
+                "phase_duration_bounds",
+                "body_model",
+                "base_poly_duration",
+                "foot_polys_per_swing",
+                "force_polys_per_stance",
+                "dt_dynamics",
+                "dt_range_of_motion",
+                "constraints",
+                "costs",
+                "swing_clearance",
+                "base_clearance",
+                "terrain",
+            )
+        ) + (
+            self.solver.hessian,
+            self.solver.tol,
+            self.solver.acceptable_tol,
+            self.solver.constr_viol_tol,
+            self.solver.linear_solver,
+            self.solver.print_level,
+        )
+
+
+def melon_config(**changes: object) -> TrajoptConfig:
+    """Melon et al.'s formulation: TOWR's constraints, their additions and analytic costs."""
+    return replace(TrajoptConfig(), **changes)  # type: ignore[arg-type]
+
+
+def towr_config(**changes: object) -> TrajoptConfig:
+    """TOWR 1.4's default problem: its constraints, no cost, its ANYmal parameters."""
+    base = TrajoptConfig(
+        constraints=TOWR_CONSTRAINTS,
+        costs=CostWeights.none(),
+        body_model="towr_anymal",
+    )
+    return replace(base, **changes)  # type: ignore[arg-type]

@@ -1,0 +1,192 @@
+"""A motion task: where the base starts and where it must end, and its checks.
+
+A task gives the base's start and goal as (x [m], y [m], yaw [rad]). The
+start state is completed as TOWR does: the feet at their nominal stance on
+the terrain, the base at its nominal height above them, at rest; the goal
+fixes the base's x, y and orientation and asks it to be at rest, its height
+left free (Winkler 2018; TOWR's ``bounds_final_lin_pos_ = {X, Y}``).
+
+The task reaches the NLP as its parameter vector p (:meth:`ResolvedTask.vector`),
+so that one built NLP serves every task.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roughwalk.errors import InvalidArgumentError
+from roughwalk.trajopt.robot_model import SingleRigidBody
+from roughwalk.trajopt.terrain_model import TerrainModel
+from roughwalk.trajopt.variables.base_angular import euler_to_rotation
+
+__all__ = ["Task", "ResolvedTask", "TASK_SIZE", "parse_pose"]
+
+# p = [start pos (3), start euler (3), start feet (12), goal xy (2), goal euler (3), goal z (1)]
+TASK_SIZE = 24
+
+
+def parse_pose(text: str, what: str = "pose") -> tuple[float, float, float]:
+    """Read "X,Y,YAW" ([m], [m], [rad]) into a tuple; raise naming the bad text."""
+    parts = [p.strip() for p in str(text).split(",")]
+    if len(parts) != 3:
+        raise InvalidArgumentError(
+            f"{what} must be X,Y,YAW (metres, metres, radians), got {text!r}"
+        )
+    try:
+        return (float(parts[0]), float(parts[1]), float(parts[2]))
+    except ValueError:
+        raise InvalidArgumentError(f"{what} must be three numbers X,Y,YAW, got {text!r}") from None
+
+
+@dataclass(frozen=True)
+class Task:
+    """Move the base from ``start`` to ``goal``, both (x [m], y [m], yaw [rad])."""
+
+    start: tuple[float, float, float]
+    goal: tuple[float, float, float]
+
+    @classmethod
+    def from_any(cls, task: Any) -> Task:
+        """A Task from a Task, a {"start", "goal"} mapping or a (start, goal) pair."""
+        if isinstance(task, Task):
+            return task
+        if isinstance(task, dict):
+            start, goal = task.get("start"), task.get("goal")
+        else:
+            try:
+                start, goal = task
+            except (TypeError, ValueError):
+                raise InvalidArgumentError(
+                    f"a task is a Task, {{'start', 'goal'}} or (start, goal), got {task!r}"
+                ) from None
+        return cls(_pose(start, "start"), _pose(goal, "goal"))
+
+    def problems(self) -> list[str]:
+        """What is wrong with the numbers themselves (NaN, infinity)."""
+        out = []
+        for what, pose in (("start", self.start), ("goal", self.goal)):
+            if not all(math.isfinite(v) for v in pose):
+                out.append(f"{what} {pose} is not finite")
+        return out
+
+
+def _pose(value: Any, what: str) -> tuple[float, float, float]:
+    if isinstance(value, str):
+        return parse_pose(value, what)
+    try:
+        x, y, yaw = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise InvalidArgumentError(f"{what} must be (x, y, yaw), got {value!r}") from None
+    return (x, y, yaw)
+
+
+@dataclass(frozen=True)
+class ResolvedTask:
+    """A task completed on a terrain for a body: the NLP's start and goal states.
+
+    Attributes
+    ----------
+    base_position:
+        (3,) start CoM position [m].
+    base_euler:
+        (3,) start Euler angles ZYX (roll, pitch, yaw) [rad].
+    feet:
+        (4, 3) start footholds [m] on the terrain.
+    goal_xy:
+        (2,) goal CoM x, y [m].
+    goal_euler:
+        (3,) goal Euler angles [rad] (level, with the goal yaw).
+    goal_z:
+        Goal CoM height [m] at the nominal stance (used by initial guesses only).
+
+    """
+
+    task: Task
+    base_position: NDArray[np.float64]
+    base_euler: NDArray[np.float64]
+    feet: NDArray[np.float64]
+    goal_xy: NDArray[np.float64]
+    goal_euler: NDArray[np.float64]
+    goal_z: float
+
+    def vector(self) -> NDArray[np.float64]:
+        """The NLP parameter vector p (TASK_SIZE,)."""
+        return np.concatenate(
+            [
+                self.base_position,
+                self.base_euler,
+                self.feet.ravel(),
+                self.goal_xy,
+                self.goal_euler,
+                [self.goal_z],
+            ]
+        )
+
+    @property
+    def goal_position(self) -> NDArray[np.float64]:
+        """(3,) goal CoM position [m] at nominal height."""
+        return np.array([self.goal_xy[0], self.goal_xy[1], self.goal_z])
+
+
+def nominal_feet(
+    body: SingleRigidBody, terrain: TerrainModel, x: float, y: float, yaw: float
+) -> tuple[NDArray[np.float64], float]:
+    """Footholds (4, 3) [m] of the nominal stance on the terrain, and the CoM height [m] there."""
+    rot = euler_to_rotation(np.array([0.0, 0.0, yaw]))
+    feet = np.array([x, y, 0.0]) + body.stance @ rot.T
+    feet[:, 2] = terrain.height(feet[:, :2])
+    return feet, float(feet[:, 2].mean() + body.nominal_height)
+
+
+def resolve(task: Task, body: SingleRigidBody, terrain: TerrainModel) -> ResolvedTask:
+    """Complete ``task`` on ``terrain`` for ``body`` (see the module docstring)."""
+    sx, sy, syaw = task.start
+    gx, gy, gyaw = task.goal
+    feet, z = nominal_feet(body, terrain, sx, sy, syaw)
+    _, goal_z = nominal_feet(body, terrain, gx, gy, gyaw)
+    return ResolvedTask(
+        task,
+        np.array([sx, sy, z]),
+        np.array([0.0, 0.0, syaw]),
+        feet,
+        np.array([gx, gy]),
+        np.array([0.0, 0.0, gyaw]),
+        goal_z,
+    )
+
+
+def stance_problems(
+    body: SingleRigidBody, terrain: TerrainModel, pose: tuple[float, float, float], what: str
+) -> list[str]:
+    """Say why the nominal stance at ``pose`` cannot be stood in.
+
+    Unknown ground, or ground more uneven than the legs reach (a pose inside
+    an obstacle). Beyond the grid the terrain continues its border, as
+    :class:`~roughwalk.terrain.Terrain` does.
+    """
+    x, y, yaw = pose
+    feet, _ = nominal_feet(body, terrain, x, y, yaw)
+    out = []
+    x_min, x_max, y_min, y_max = terrain.extent
+    inside = (
+        (feet[:, 0] >= x_min)
+        & (feet[:, 0] <= x_max)
+        & (feet[:, 1] >= y_min)
+        & (feet[:, 1] <= y_max)
+    )
+    known = terrain.terrain.is_known(feet[inside, :2]) if inside.any() else np.ones(0, bool)
+    if not np.all(known):
+        out.append(f"{what} ({x:g}, {y:g}): the feet would stand on unknown terrain")
+    spread = float(np.ptp(feet[:, 2]))
+    reach = 2.0 * body.max_deviation[2]
+    if spread > reach:
+        out.append(
+            f"{what} ({x:g}, {y:g}) is inside an obstacle: the nominal footholds span "
+            f"{spread:.3f} m of height, more than the {reach:.3f} m the legs can reach"
+        )
+    return out

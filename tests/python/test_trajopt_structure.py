@@ -1,0 +1,155 @@
+"""The NLP's structure: TOWR's variable counts, gaits, splines with symbolic durations."""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from roughwalk.errors import ConfigError, InvalidArgumentError
+from roughwalk.terrain import load_terrain
+from roughwalk.trajopt import (
+    GAIT_NAMES,
+    TOWR_ANYMAL,
+    Formulation,
+    HeuristicInitializer,
+    TerrainModel,
+    make_gait,
+    towr_config,
+    valid_step_counts,
+)
+from roughwalk.trajopt.task import Task, resolve
+from roughwalk.trajopt.variables import NodeSpline, NumericSpline, hermite_point
+
+
+@pytest.fixture(scope="module")
+def flat() -> TerrainModel:
+    return TerrainModel(load_terrain("flat"))
+
+
+def _formulation(
+    flat: TerrainModel, duration: float, optimize: bool, **changes: object
+) -> Formulation:
+    config = towr_config(optimize_durations=optimize, **changes)
+    return Formulation(config, TOWR_ANYMAL, make_gait("walk", 16, duration), flat)
+
+
+def test_variable_counts_equal_towrs(flat: TerrainModel) -> None:
+    # TOWR 1.4, ANYmal, 16-step walk: 848 variables at T = 3.4 s with fixed
+    # durations, 952 at T = 4.0 s with optimised ones (Melon 2020, §V).
+    assert _formulation(flat, 3.4, False).n_variables == 848
+    assert _formulation(flat, 4.0, True).n_variables == 952
+    # Constraints add rows, never variables.
+    assert _formulation(flat, 4.0, True, constraints=()).n_variables == 952
+
+
+def test_variable_count_matches_melons_formula(flat: TerrainModel) -> None:
+    # N = 12 T/dt + 20 S + 120 (+ 2S with optimised durations), Melon 2020 §III-A.
+    for duration in (2.4, 3.0, 5.5):
+        n_fixed = 12 * round(duration / 0.1) + 20 * 16 + 120
+        fixed = _formulation(flat, duration, False, constraints=())
+        free = _formulation(flat, duration, True, constraints=())
+        assert fixed.n_variables == n_fixed
+        assert free.n_variables == n_fixed + 2 * 16
+
+
+def test_gaits_make_their_step_counts() -> None:
+    assert valid_step_counts("walk", 4) == [4, 8, 12, 16]
+    assert valid_step_counts("trot", 4) == [2, 6, 10, 14]
+    for gait in GAIT_NAMES:
+        for steps in valid_step_counts(gait, 3):
+            schedule = make_gait(gait, steps, 3.0)
+            assert schedule.steps == steps
+            for durations in schedule.durations:
+                assert sum(durations) == pytest.approx(3.0)
+                assert min(durations) > 0
+            # Every gait opens and closes with all four feet down.
+            assert all(schedule.in_contact_at_start)
+            assert all(schedule.in_contact(f, 3.0)[0] for f in range(4))
+
+
+def test_bad_gaits_are_refused_by_name() -> None:
+    with pytest.raises(InvalidArgumentError, match="walk gait cannot make 14 steps.*4, 8, 12"):
+        make_gait("walk", 14, 3.0)
+    with pytest.raises(InvalidArgumentError, match="unknown gait 'amble'.*walk, trot"):
+        make_gait("amble", 4, 3.0)
+    with pytest.raises(ConfigError, match="unknown constraint 'friction'"):
+        _formulation(TerrainModel(load_terrain("flat")), 2.0, False, constraints=("friction",))
+
+
+def test_numeric_spline_is_the_hermite_polynomial() -> None:
+    rng = np.random.default_rng(0)
+    pos, vel = rng.normal(size=(4, 3)), rng.normal(size=(4, 3))
+    durations = np.array([0.3, 0.2, 0.5])
+    spline = NumericSpline(pos, vel, durations)
+    # Nodes are hit with their values and derivatives.
+    p, v, _ = spline.evaluate([0.0, 0.3, 0.5, 1.0])
+    np.testing.assert_allclose(p, pos, atol=1e-12)
+    np.testing.assert_allclose(v, vel, atol=1e-12)
+    # Velocity and acceleration are the derivatives of position (central differences).
+    t = np.linspace(0.01, 0.99, 37)
+    h = 1e-6
+    p_plus, v_plus, _ = spline.evaluate(t + h)
+    p_minus, v_minus, _ = spline.evaluate(t - h)
+    _, v_mid, a_mid = spline.evaluate(t)
+    inside = np.all(np.abs(t[:, None] - np.array([0.3, 0.5])) > 2 * h, axis=1)
+    np.testing.assert_allclose(((p_plus - p_minus) / (2 * h))[inside], v_mid[inside], atol=1e-6)
+    np.testing.assert_allclose(((v_plus - v_minus) / (2 * h))[inside], a_mid[inside], atol=1e-5)
+
+
+def test_symbolic_durations_pick_the_right_polynomial() -> None:
+    # With symbolic durations the spline sums switched candidates; at any
+    # durations it must equal the plain numeric spline.
+    rng = np.random.default_rng(1)
+    pos, vel = rng.normal(size=(5, 3)), rng.normal(size=(5, 3))
+    d = ca.SX.sym("d", 4)
+    windows = [(0.2 * k, 1.0 * (k + 1)) for k in range(4)]
+    spline = NodeSpline(list(pos), list(vel), [d[k] for k in range(4)], windows)
+    times = np.linspace(0.0, 1.6, 41)
+    f = ca.Function("f", [d], [ca.horzcat(*[ca.vertcat(*spline.point(t)) for t in times])])
+    for durations in ([0.4, 0.4, 0.4, 0.4], [0.25, 0.7, 0.2, 0.45], [0.2, 0.2, 0.2, 1.0]):
+        values = np.asarray(f(durations))
+        ref = NumericSpline(pos, vel, durations)
+        t_in = np.minimum(times, sum(durations))
+        p, v, a = ref.evaluate(t_in)
+        ok = times <= sum(durations) + 1e-12
+        np.testing.assert_allclose(values[0:3, ok].T, p[ok], atol=1e-10)
+        np.testing.assert_allclose(values[3:6, ok].T, v[ok], atol=1e-10)
+        np.testing.assert_allclose(values[6:9, ok].T, a[ok], atol=1e-9)
+
+
+def test_optimised_durations_give_the_fixed_problem_at_equal_durations(flat: TerrainModel) -> None:
+    # The same task, guess and durations through both formulations: every
+    # constraint value must agree, so the duration machinery changes nothing
+    # but the freedom. Durations are kept in their 0.2–1.0 s bounds, as IPOPT
+    # keeps every iterate.
+    free = _formulation(flat, 5.5, True)
+    durations = []
+    for d in free.durations:
+        inner = np.clip(d.nominal[:-1], 0.2, 1.0)
+        durations.append([*inner, d.total - inner.sum()])
+    schedule = make_gait("walk", 16, 5.5).with_durations(durations)
+    fixed = Formulation(towr_config(), TOWR_ANYMAL, schedule, flat)
+    task = resolve(Task((0.0, 0.0, 0.0), (1.0, 0.1, 0.2)), TOWR_ANYMAL, flat)
+    rng = np.random.default_rng(2)
+    x_fixed = HeuristicInitializer().guess(fixed, task)
+    x_fixed = x_fixed + rng.normal(scale=0.01, size=x_fixed.size)
+    parts = fixed.split(x_fixed)
+    for d, values in zip(free.durations, durations, strict=True):
+        parts[d.name] = d.pack(values)
+    x_free = free.join(parts)
+    _, g_fixed, _ = fixed.evaluator(x_fixed, task.vector())
+    _, g_free, _ = free.evaluator(x_free, task.vector())
+    g_free = np.asarray(g_free).ravel()
+    g_fixed = np.asarray(g_fixed).ravel()
+    free_rows = free.row_slices()
+    for name, rows in fixed.row_slices().items():
+        np.testing.assert_allclose(g_free[free_rows[name]], g_fixed[rows], atol=1e-9, err_msg=name)
+
+
+def test_hermite_point_matches_its_definition() -> None:
+    x0, v0, x1, v1, d = 0.3, -1.0, 1.2, 0.5, 0.7
+    p0, dp0, _ = hermite_point(x0, v0, x1, v1, d, 0.0)
+    p1, dp1, _ = hermite_point(x0, v0, x1, v1, d, d)
+    assert (p0, dp0) == pytest.approx((x0, v0))
+    assert (p1, dp1) == pytest.approx((x1, v1))
