@@ -16,6 +16,7 @@ from roughwalk.errors import (
 from roughwalk.robots import Robot, load_robot
 from roughwalk.terrain import Terrain, load_terrain
 from roughwalk.trajopt import optimize_motion
+from roughwalk.trajectories.api import footstep_trajectories
 
 __all__ = [
     "__version__",
@@ -30,4 +31,5 @@ __all__ = [
     "Robot",
     "load_robot",
     "optimize_motion",
+    "footstep_trajectories",
 ]

@@ -1,0 +1,229 @@
+"""CHOMP's first coordinate block: the trunk trajectory (Zucker 2011, §5.3).
+
+"First, the body trajectory is optimized with CHOMP, given the current swing
+leg joint angles." The variables are the trunk's (x, y, z, roll, pitch, yaw)
+at the interior samples; the supporting legs follow by IK, the lifted leg
+keeps its joint angles. The objective gathers the smoothness of the change,
+the obstacle cost of every body point (supporting feet excepted),
+reachability of the supporting feet and the ZMP support margin.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roughwalk.trajectories.chomp import Evaluation
+from roughwalk.trajectories.config import ChompConfig, ValidityConfig
+from roughwalk.trajectories.costs.obstacle import ObstacleCost
+from roughwalk.trajectories.costs.reachability import reachability_cost
+from roughwalk.trajectories.costs.smoothness import Smoothness
+from roughwalk.trajectories.costs.support import ZmpSupportCost
+from roughwalk.trajectories.euler import rpy_rate_matrix, rpy_to_matrix
+from roughwalk.trajectories.initial_trajectory import FootstepState
+from roughwalk.trajectories.whole_body import WholeBody
+
+__all__ = ["BodyPass", "clearance_ok", "velocity_ok", "velocity_excess"]
+
+
+def clearance_ok(
+    clearance: NDArray[np.float64],
+    active: NDArray[np.bool_],
+    is_foot: NDArray[np.bool_],
+    validity: ValidityConfig,
+) -> bool:
+    """Whether active points (T, U) keep the clearance the validity settings ask for."""
+    need = np.where(is_foot, -validity.foot_tolerance, validity.min_clearance)
+    return bool(np.all((clearance >= need[None, :]) | ~active))
+
+
+def velocity_excess(q: NDArray[np.float64], dt: float, limit: NDArray[np.float64]) -> float:
+    """Σ max(0, |Δq| − v·dt) [rad] of joint angles (T, ...) sampled every ``dt`` [s].
+
+    ``limit`` (...) holds the velocity limits [rad/s].
+    """
+    return float(np.sum(np.maximum(np.abs(np.diff(q, axis=0)) - limit[None] * dt, 0.0)))
+
+
+def velocity_ok(q: NDArray[np.float64], dt: float, limit: NDArray[np.float64]) -> bool:
+    """Whether joint angles (T, 4, 3) sampled every ``dt`` [s] keep to ``limit`` (4, 3) [rad/s]."""
+    return velocity_excess(q, dt, limit) == 0.0
+
+
+class BodyPass:
+    """The trunk block of one footstep's CHOMP: :meth:`evaluate` for :class:`Chomp`.
+
+    Parameters
+    ----------
+    wb:
+        Batched kinematics (with the body points).
+    state:
+        The footstep's current trajectory; read, and written by :meth:`apply`.
+    obstacle:
+        The obstacle term over ``wb.points``.
+    config, validity:
+        Weights and the feasibility thresholds.
+    gravity:
+        g [m/s²] of the ZMP.
+    reference:
+        The interior trunk path (n, 6) whose changes the smoothness term
+        penalises (default: the state's current one).
+    """
+
+    def __init__(
+        self,
+        wb: WholeBody,
+        state: FootstepState,
+        obstacle: ObstacleCost,
+        config: ChompConfig,
+        validity: ValidityConfig,
+        gravity: float = 9.81,
+        reference: NDArray[np.float64] | None = None,
+    ) -> None:
+        self.wb = wb
+        self.state = state
+        self.obstacle = obstacle
+        self.config = config
+        self.validity = validity
+        t = state.n_samples
+        self.h = 1.0 / (t - 1)
+        r2 = config.rotation_scale**2
+        # The trunk is held where the swing leg changes hands between IK and
+        # its own joint angles (lift-off, touchdown), so the leg stays continuous.
+        fixed = np.zeros(t - 2, dtype=bool)
+        for k in (state.lift_off, state.touchdown):
+            if 0 < k < t - 1:
+                fixed[k - 1] = True
+        self.smoothness = Smoothness(
+            state.body[1:-1] if reference is None else reference,
+            config.smoothness_order,
+            config.smoothness_weight,
+            [1, 1, 1, r2, r2, r2],
+            fixed=fixed,
+        )
+        self.support_cost = ZmpSupportCost(
+            state.polygons,
+            state.polygon_index,
+            state.com_offset[:, :2],
+            state.com_offset_acceleration[:, :2],
+            state.com_height,
+            state.dt,
+            config.zmp_margin,
+            config.support_weight * self.h,
+            gravity,
+        )
+        pts = wb.points
+        leg = np.maximum(pts.leg, 0)
+        foot_down = pts.is_foot[None, :] & state.support[:, leg]
+        self.active = ~foot_down
+        self.held_q = state.q.copy()
+        self.hips = wb.robot.hip_positions
+
+    def configure(
+        self, xi: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
+        """Full trunk path (T, 6), rotations (T, 3, 3), joint angles (T, 4, 3), reached (T, 4)."""
+        s = self.state
+        body = s.body.copy()
+        body[1:-1] = xi
+        rot = rpy_to_matrix(body[:, 3:])
+        feet_b = np.einsum("tji,tlj->tli", rot, s.feet - body[:, None, :3])
+        q_ik, reached = self.wb.inverse_kinematics(feet_b)
+        q = np.where(s.support[..., None], q_ik, self.held_q)
+        reached = reached | ~s.support
+        return body, rot, q, reached
+
+    def reach_errors(
+        self, body: NDArray[np.float64], rot: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """Reach errors e = f′ − FK(IK(f′)) (T, 4, 3) [m, world].
+
+        f′ is the foot target pushed ``reach_margin`` away from its hip.
+
+        Asking for a slightly longer leg makes the term act before a foot is
+        lost (a plain ½‖e‖² penalty settles slightly outside the
+        workspace); its gradient is the §3.2 virtual force.
+        """
+        s = self.state
+        feet_b = np.einsum("tji,tlj->tli", rot, s.feet - body[:, None, :3])
+        towards = feet_b - self.hips[None]
+        dist = np.linalg.norm(towards, axis=-1, keepdims=True)
+        pushed = feet_b + self.config.reach_margin * towards / np.maximum(dist, 1e-9)
+        q, _ = self.wb.inverse_kinematics(pushed)
+        error_b = pushed - self.wb.foot_positions(q)
+        return np.einsum("tij,tlj->tli", rot, error_b)
+
+    def evaluate(self, xi: NDArray[np.float64]) -> Evaluation:
+        """Obstacle + reachability + support terms and their gradient (n, 6) at ξ."""
+        s = self.state
+        wb = self.wb
+        body, rot, q, reached = self.configure(xi)
+        frames = wb.link_frames(q)
+        p_b, feet_b = wb.points_base(q, frames)
+        points = body[:, None, :3] + np.einsum("tij,tuj->tui", rot, p_b)
+        obs = self.obstacle.evaluate(points, self.active)
+        ti, ui = ObstacleCost.gradient_pairs(obs.workspace_gradient)
+        jac = wb.body_pass_jacobians_at(
+            q, frames, p_b, feet_b, rot, body[:, 3:], s.support, ti + 1, ui
+        )
+        n = body.shape[0] - 2
+        grad = ObstacleCost.to_coordinates(obs.workspace_gradient, jac, ti, ui, n)
+
+        errors = self.reach_errors(body, rot)
+        inner = slice(1, -1)
+        reach_value, reach_grad = reachability_cost(
+            errors[inner],
+            s.feet[inner],
+            body[inner, :3],
+            rpy_rate_matrix(body[inner, 3:]),
+            s.support[inner],
+            self.config.reachability_weight * self.h,
+        )
+        grad += reach_grad
+        sup_value, sup_grad, margins = self.support_cost.evaluate(body[:, :2])
+        grad[:, :2] += sup_grad
+        excess = velocity_excess(q, s.dt, self.wb.velocity_limit)
+        lost = float(np.sum(~reached))
+        feasible = (
+            lost == 0
+            and excess == 0.0
+            and clearance_ok(obs.clearance, self.active, self.wb.points.is_foot, self.validity)
+            and bool(np.all(margins >= -self.validity.zmp_tolerance))
+        )
+        return Evaluation(
+            value=obs.value + reach_value + sup_value,
+            gradient=grad,
+            parts={"obstacle": obs.value, "reachability": reach_value, "support": sup_value},
+            feasible=feasible,
+            violation=lost + excess,
+        )
+
+    def apply(self, xi: NDArray[np.float64]) -> None:
+        """Write the optimised trunk path into the state (legs re-solved, swing foot carried)."""
+        s = self.state
+        body, rot, q, reached = self.configure(xi)
+        s.body = body
+        s.q = q
+        s.reached = reached
+        airborne = ~s.support
+        if np.any(airborne):
+            feet_w = body[:, None, :3] + np.einsum("tij,tlj->tli", rot, self.wb.foot_positions(q))
+            s.feet = np.where(airborne[..., None], feet_w, s.feet)
+
+    def feasible_without_leg(self, leg: int) -> bool:
+        """Whether all but leg ``leg``'s points and joints is feasible at the current state."""
+        s = self.state
+        body, rot, q, reached = self.configure(s.body[1:-1])
+        p_b, _ = self.wb.points_base(q)
+        points = body[:, None, :3] + np.einsum("tij,tuj->tui", rot, p_b)
+        d, _ = self.obstacle.clearance(points)
+        others = self.wb.points.leg != leg
+        active = self.active & others[None, :]
+        margins = self.support_cost.margins(self.support_cost.zmp(body[:, :2]))[0]
+        keep = np.arange(4) != leg
+        return (
+            bool(np.all(reached))
+            and clearance_ok(d, active, self.wb.points.is_foot, self.validity)
+            and bool(np.all(margins >= -self.validity.zmp_tolerance))
+            and velocity_ok(q[:, keep], s.dt, self.wb.velocity_limit[keep])
+        )

@@ -1,0 +1,364 @@
+"""Settings of footstep trajectory generation (Zucker 2011, §5), with units and trade-offs.
+
+Override any field by dotted key: ``footstep_trajectories(plan,
+**{"chomp.max_iterations": 30})`` or ``roughwalk trajectory --set
+chomp.max_iterations=30``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from roughwalk.errors import ConfigError
+
+__all__ = [
+    "TrajectoryConfig",
+    "TimingConfig",
+    "ZmpConfig",
+    "SwingConfig",
+    "ChompConfig",
+    "ValidityConfig",
+]
+
+
+def _check_positive(obj: object, names: tuple[str, ...], prefix: str) -> None:
+    for name in names:
+        v = getattr(obj, name)
+        if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
+            raise ConfigError(f"{prefix}.{name} must be a positive number, got {v!r}")
+
+
+def _check_nonnegative(obj: object, names: tuple[str, ...], prefix: str) -> None:
+    for name in names:
+        v = getattr(obj, name)
+        if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
+            raise ConfigError(f"{prefix}.{name} must be a number ≥ 0, got {v!r}")
+
+
+@dataclass(frozen=True)
+class TimingConfig:
+    """How long each footstep takes (Zucker 2011, §5.2).
+
+    Attributes
+    ----------
+    velocity_margin:
+        Factor (≥ 1) on the shift phase's minimum time, the largest joint
+        travel over its velocity limit (§5.2). The CoM's smooth motion peaks
+        near twice its mean speed, so values below ~2 make the velocity check
+        fail and cost restarts; larger values walk slower.
+    swing_velocity_margin:
+        Factor (≥ 1) on the swing's minimum time, the duration at which the
+        foot spline's peak joint speeds reach the limits. The trunk moves
+        during the swing too, hence a little slack.
+    min_shift_s:
+        Shortest shift phase [s] (four feet down, centre of pressure moved
+        into the next support triangle). The cart-table needs time to move
+        its ZMP: shorter shifts swing the trunk harder.
+    min_swing_s:
+        Shortest swing phase [s].
+    max_step_s:
+        Longest a step may be made by restarts [s].
+    settle_s:
+        After the last step, four feet down while the centre of mass comes to
+        rest over the final pose [s].
+    """
+
+    velocity_margin: float = 2.0
+    swing_velocity_margin: float = 1.25
+    min_shift_s: float = 0.3
+    min_swing_s: float = 0.4
+    max_step_s: float = 4.0
+    settle_s: float = 0.8
+
+    def __post_init__(self) -> None:
+        _check_positive(self, ("min_shift_s", "min_swing_s", "max_step_s"), "timing")
+        _check_nonnegative(self, ("settle_s",), "timing")
+        for name in ("velocity_margin", "swing_velocity_margin"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v >= 1):
+                raise ConfigError(f"timing.{name} must be ≥ 1, got {v}")
+
+
+@dataclass(frozen=True)
+class ZmpConfig:
+    """The ZMP reference and its preview controller (Kajita et al. 2003; Zucker 2011, §5.2).
+
+    Attributes
+    ----------
+    tracking_weight:
+        Weight Q on the squared ZMP error [1/m²]. Only its ratio to
+        ``jerk_weight`` matters.
+    jerk_weight:
+        Weight R on the squared CoM jerk [s⁶/m²]. Smaller tracks the
+        reference more tightly with more trunk motion.
+    preview_steps:
+        The preview window spans this many footsteps from the current one
+        (the paper: three). Beyond the window the reference is held.
+    shortcut:
+        Try the "shortcut" ZMP of the paper's footnote 2 first: the point of
+        the support triangle (shrunk by ``support_margin``) nearest to the
+        straight line between the neighbouring anchors, so the trunk sways
+        less. Falls back to the certificate when it collides or fails.
+    support_margin:
+        Distance [m] the shortcut point keeps inside its support triangle.
+    gravity:
+        Gravitational acceleration [m/s²].
+    """
+
+    tracking_weight: float = 1.0
+    jerk_weight: float = 1e-6
+    preview_steps: int = 3
+    shortcut: bool = True
+    support_margin: float = 0.015
+    gravity: float = 9.81
+
+    def __post_init__(self) -> None:
+        _check_positive(self, ("tracking_weight", "jerk_weight", "gravity"), "zmp")
+        _check_nonnegative(self, ("support_margin",), "zmp")
+        if not (isinstance(self.preview_steps, int) and self.preview_steps >= 1):
+            raise ConfigError(f"zmp.preview_steps must be an integer ≥ 1, got {self.preview_steps}")
+
+
+@dataclass(frozen=True)
+class SwingConfig:
+    """The swing foot's initial spline: start → lift-off → drop-off → target (§5.2).
+
+    Attributes
+    ----------
+    lift_height:
+        Lift-off and drop-off points are at least this high [m] above the
+        higher of start and target.
+    clearance:
+        With ``scan_terrain``, the path between lift-off and drop-off also
+        clears the highest terrain under the straight foot path by this much
+        [m] (foot sphere included). More clearance avoids collisions that
+        CHOMP would have to fix, at the price of longer, faster swings.
+    scan_terrain:
+        Look at the terrain under the foot path (else only ``lift_height``).
+    lift_fraction:
+        Where lift-off and drop-off sit along the stride (0: straight above
+        start and target; 0.5: both at the middle). Small values lift
+        vertically first; larger ones round the corners.
+    """
+
+    lift_height: float = 0.03
+    clearance: float = 0.025
+    scan_terrain: bool = True
+    lift_fraction: float = 0.1
+
+    def __post_init__(self) -> None:
+        _check_nonnegative(self, ("lift_height", "clearance"), "swing")
+        if not (math.isfinite(self.lift_fraction) and 0 <= self.lift_fraction < 0.5):
+            raise ConfigError(f"swing.lift_fraction must be in [0, 0.5), got {self.lift_fraction}")
+
+
+@dataclass(frozen=True)
+class ChompConfig:
+    """The CHOMP optimiser (Ratliff et al. 2009; Zucker 2011, §5.1 and §5.3).
+
+    Attributes
+    ----------
+    rate_hz:
+        Sample rate of ξ [Hz] (the paper: half the control rate). Thanks to
+        the covariant update the result hardly depends on it; the cost is
+        linear in it.
+    max_iterations:
+        Iteration limit per attempt (body and swing iterations together).
+    body_iterations, swing_iterations:
+        Iterations of each coordinate-descent block: first the trunk with the
+        supporting legs by IK, then the swing leg's joints.
+    smoothness_order:
+        1 penalises squared velocities, 2 squared accelerations of the change
+        ξ − ξ₀ from the initial trajectory (so the ZMP-planned motion is kept
+        where nothing pushes it). 2 spreads corrections more smoothly.
+    smoothness_weight:
+        λ in U = f_obs + λ·f_smooth + ... Larger keeps closer to the initial
+        trajectory, smaller lets the obstacles push further.
+    obstacle_weight:
+        Weight of the workspace obstacle cost [1/m²].
+    obstacle_epsilon:
+        ε [m]: the obstacle potential is zero beyond this clearance and
+        quadratic inside it (Ratliff 2009). It is the clearance CHOMP aims for.
+    reachability_weight:
+        Weight of ½Σ‖f′ − FK(IK(f′))‖² over the supporting legs [1/m²] (§3.2),
+        f′ the foot target pushed ``reach_margin`` away from its hip.
+    reach_margin:
+        [m] how far inside the leg's workspace the reachability term starts
+        to act, so that its optimum keeps the feet reachable.
+    support_weight:
+        Weight of the squared shortfall of the ZMP margin to the support
+        polygon below ``zmp_margin`` [1/m²] (the static-stability term, with
+        the cart-table's ZMP in place of the CoM).
+    zmp_margin:
+        Margin [m] inside the support polygon the support term asks for.
+    speed_weight:
+        Weight of ½Σ max(0, |q̇| − ρ·v)² over the swing leg's joints [s²/rad²]
+        (not in the paper, which only lengthens steps that break the limits).
+    speed_fraction:
+        ρ: the fraction of each joint's velocity limit above which that term acts.
+    step_size:
+        α in ξ ← ξ − α·A⁻¹∇U.
+    max_step:
+        Trust region: an update moving any sample by more than this [m] (or
+        its rotation by more than max_step / rotation_scale [rad]) is scaled
+        down.
+    rotation_scale:
+        [m/rad]: one radian of trunk rotation counts like this much trunk
+        displacement in the metric.
+    joint_scale:
+        [m/rad]: one radian of a swing joint counts like this much foot
+        displacement in the metric.
+    point_spacing:
+        Spacing [m] of the body points along the collision capsules.
+    gradient:
+        ``"functional"``: Ratliff 2009's functional gradient of the
+        arc-length-weighted potential, ‖ẋ‖·[(I − x̂′x̂′ᵀ)∇c − c·κ], projected
+        orthogonally to each body point's path. ``"exact"``: the Euclidean
+        gradient of the discretised objective (the same in the limit).
+    line_search:
+        Halve a step that would raise the objective (up to 6 times) instead of
+        taking it; stop when no halving helps.
+    max_restarts:
+        If the result collides or breaks a velocity limit, lengthen the step,
+        regenerate the initial trajectory and restart, at most this often.
+    restart_duration_factor:
+        Factor (> 1) on the step duration at each restart.
+    """
+
+    rate_hz: float = 50.0
+    max_iterations: int = 40
+    body_iterations: int = 10
+    swing_iterations: int = 10
+    smoothness_order: int = 2
+    smoothness_weight: float = 1.0
+    obstacle_weight: float = 400.0
+    obstacle_epsilon: float = 0.015
+    reachability_weight: float = 2000.0
+    reach_margin: float = 0.005
+    support_weight: float = 200.0
+    zmp_margin: float = 0.005
+    speed_weight: float = 0.05
+    speed_fraction: float = 0.8
+    step_size: float = 0.2
+    max_step: float = 0.01
+    rotation_scale: float = 0.1
+    joint_scale: float = 0.08
+    point_spacing: float = 0.02
+    gradient: str = "functional"
+    line_search: bool = True
+    max_restarts: int = 3
+    restart_duration_factor: float = 1.3
+
+    def __post_init__(self) -> None:
+        _check_positive(
+            self,
+            (
+                "rate_hz",
+                "smoothness_weight",
+                "obstacle_epsilon",
+                "step_size",
+                "max_step",
+                "rotation_scale",
+                "joint_scale",
+                "point_spacing",
+            ),
+            "chomp",
+        )
+        _check_nonnegative(
+            self,
+            (
+                "obstacle_weight",
+                "reachability_weight",
+                "reach_margin",
+                "support_weight",
+                "zmp_margin",
+                "speed_weight",
+            ),
+            "chomp",
+        )
+        for name in ("max_iterations", "body_iterations", "swing_iterations", "max_restarts"):
+            v = getattr(self, name)
+            if not (isinstance(v, int) and v >= 0):
+                raise ConfigError(f"chomp.{name} must be an integer ≥ 0, got {v!r}")
+        if self.body_iterations + self.swing_iterations == 0 and self.max_iterations > 0:
+            raise ConfigError("chomp.body_iterations and chomp.swing_iterations are both 0")
+        if not (math.isfinite(self.speed_fraction) and 0 < self.speed_fraction <= 1):
+            raise ConfigError(f"chomp.speed_fraction must be in (0, 1], got {self.speed_fraction}")
+        if self.smoothness_order not in (1, 2):
+            raise ConfigError(
+                f"chomp.smoothness_order must be 1 (velocity) or 2 (acceleration), "
+                f"got {self.smoothness_order!r}"
+            )
+        if self.gradient not in ("functional", "exact"):
+            raise ConfigError(
+                f"chomp.gradient must be 'functional' or 'exact', got {self.gradient!r}"
+            )
+        if not (math.isfinite(self.restart_duration_factor) and self.restart_duration_factor > 1):
+            raise ConfigError(
+                f"chomp.restart_duration_factor must be > 1, got {self.restart_duration_factor}"
+            )
+
+
+@dataclass(frozen=True)
+class ValidityConfig:
+    """When a footstep trajectory counts as valid (and when CHOMP may stop early).
+
+    Attributes
+    ----------
+    min_clearance:
+        Every collision capsule except the supporting feet must keep this
+        distance [m] from the terrain (0: touching is allowed).
+    foot_tolerance:
+        The swing foot may dip this far [m] into the terrain's distance field
+        (it starts and ends touching the ground; the paper allows light foot
+        contact).
+    zmp_tolerance:
+        The ZMP may leave the support polygon by at most this much [m].
+    """
+
+    min_clearance: float = 0.0
+    foot_tolerance: float = 0.001
+    zmp_tolerance: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.min_clearance):
+            raise ConfigError(f"validity.min_clearance must be finite, got {self.min_clearance}")
+        _check_nonnegative(self, ("foot_tolerance", "zmp_tolerance"), "validity")
+
+
+@dataclass(frozen=True)
+class TrajectoryConfig:
+    """Everything :func:`roughwalk.footstep_trajectories` can be told.
+
+    Attributes
+    ----------
+    control_rate_hz:
+        Rate [Hz] of the output joint angles and velocities. The checks of
+        clearance and velocity limits run at this rate.
+    sdf_resolution:
+        Voxel size [m] of the terrain's signed distance field when one has to
+        be built (5 mm as in the paper).
+    timing, zmp, swing, chomp, validity:
+        The stages' settings.
+    """
+
+    control_rate_hz: float = 100.0
+    sdf_resolution: float = 0.005
+    timing: TimingConfig = field(default_factory=TimingConfig)
+    zmp: ZmpConfig = field(default_factory=ZmpConfig)
+    swing: SwingConfig = field(default_factory=SwingConfig)
+    chomp: ChompConfig = field(default_factory=ChompConfig)
+    validity: ValidityConfig = field(default_factory=ValidityConfig)
+
+    def __post_init__(self) -> None:
+        _check_positive(self, ("control_rate_hz", "sdf_resolution"), "trajectory")
+        for name, kind in (
+            ("timing", TimingConfig),
+            ("zmp", ZmpConfig),
+            ("swing", SwingConfig),
+            ("chomp", ChompConfig),
+            ("validity", ValidityConfig),
+        ):
+            if not isinstance(getattr(self, name), kind):
+                raise ConfigError(f"{name} must be a {kind.__name__}")

@@ -1,0 +1,396 @@
+"""From footsteps to full-body trajectories, one footstep at a time (Zucker 2011, §5).
+
+For each footstep: estimate its timing from the joint velocity limits, build
+the initial trajectory (ZMP preview over a window of the next footsteps,
+certificate splines, swing spline, IK), run CHOMP as coordinate descent
+(trunk, then swing leg) until the trajectory is valid or the iterations run
+out, check it at the control rate, and if it still collides or breaks a
+velocity limit, lengthen the step, regenerate and restart. The first attempt
+uses the shortcut ZMP (footnote 2) where it is safe, and the restarts fall
+back to the certificate. A step that stays infeasible is marked and handed on
+("in our system we chose instead to optimistically execute these
+known-infeasible trajectories", §5.3).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roughwalk.errors import InvalidArgumentError
+from roughwalk.trajectories.body_keyframes import BodyKeyframe, keyframe_at
+from roughwalk.trajectories.body_pass import BodyPass
+from roughwalk.trajectories.chomp import Chomp, ChompStatus
+from roughwalk.trajectories.config import TrajectoryConfig
+from roughwalk.trajectories.costs.obstacle import ObstacleCost
+from roughwalk.trajectories.footstep_trajectory import FootstepTrajectory, resample_footstep
+from roughwalk.trajectories.initial_trajectory import (
+    FootstepState,
+    StartState,
+    build_initial_trajectory,
+)
+from roughwalk.trajectories.step_report import capsule_clearances
+from roughwalk.trajectories.step_sequence import StepSequence
+from roughwalk.trajectories.swing_pass import SwingPass
+from roughwalk.trajectories.swing_spline import SwingSpline
+from roughwalk.trajectories.timing import StepTiming, step_timing
+from roughwalk.trajectories.whole_body import WholeBody
+from roughwalk.trajectories.zmp_preview import ZmpPreviewController
+from roughwalk.trajectories.zmp_reference import ZmpReference, shortcut_anchor
+
+if TYPE_CHECKING:
+    from roughwalk.robots.robot import Robot
+    from roughwalk.terrain.terrain import Terrain
+
+__all__ = ["FootstepTrajectoryGenerator", "OptimizationOutcome", "PreparedPlan"]
+
+
+@dataclass(frozen=True)
+class PreparedPlan:
+    """A plan read for generation.
+
+    Its steps, nominal timings (§5.2), the shortcut pose of each step or None
+    (footnote 2), the ZMP anchors in use, and the start.
+    """
+
+    sequence: StepSequence
+    timings: list[StepTiming]
+    shortcuts: list[BodyKeyframe | None]
+    anchors: NDArray[np.float64]
+    start: StartState
+
+
+class OptimizationOutcome:
+    """How CHOMP went on one attempt: iterations used and the final status."""
+
+    def __init__(self, iterations: int, status: ChompStatus) -> None:
+        self.iterations = iterations
+        self.status = status
+
+
+class FootstepTrajectoryGenerator:
+    """Makes :class:`FootstepTrajectory` objects for the footsteps of plans on one terrain.
+
+    Parameters
+    ----------
+    robot:
+        The robot.
+    terrain:
+        The terrain (for the swing spline's terrain scan and, unless ``sdf``
+        is given, to build the signed distance field).
+    sdf:
+        A prebuilt :class:`~roughwalk.terrain.SignedDistanceField` of ``terrain``.
+    config:
+        Settings (default :class:`TrajectoryConfig`).
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        terrain: Terrain | None,
+        *,
+        sdf: Any = None,
+        config: TrajectoryConfig | None = None,
+    ) -> None:
+        self.config = config if config is not None else TrajectoryConfig()
+        if sdf is None and terrain is None:
+            raise InvalidArgumentError("a terrain or its signed distance field is needed")
+        self.robot = robot
+        self.terrain = terrain if terrain is not None else sdf.terrain
+        self._sdf = sdf
+        self.wb = WholeBody(robot, point_spacing=self.config.chomp.point_spacing)
+        self.dt = 1.0 / self.config.chomp.rate_hz
+        self._controllers: dict[int, ZmpPreviewController] = {}
+
+    @property
+    def sdf(self) -> Any:
+        """The terrain's signed distance field (built on first use)."""
+        if self._sdf is None:
+            self._sdf = self.terrain.sdf(self.config.sdf_resolution)
+        return self._sdf
+
+    # ---- pieces -------------------------------------------------------------------
+
+    def sequence(self, plan: Any) -> StepSequence:
+        """Read a plan (see :func:`~roughwalk.trajectories.step_sequence.plan_fields`)."""
+        if isinstance(plan, StepSequence):
+            return plan
+        return StepSequence.from_plan(plan, self.wb, self.config.zmp.support_margin)
+
+    def controller(self, com_height: float) -> ZmpPreviewController:
+        """The preview controller for a CoM height [m] (cached per millimetre)."""
+        key = max(int(round(com_height * 1000)), 1)
+        if key not in self._controllers:
+            z = self.config.zmp
+            self._controllers[key] = ZmpPreviewController(
+                key / 1000.0,
+                self.dt,
+                tracking_weight=z.tracking_weight,
+                jerk_weight=z.jerk_weight,
+                gravity=z.gravity,
+            )
+        return self._controllers[key]
+
+    def nominal_timings(self, seq: StepSequence) -> list[StepTiming]:
+        """Each footstep's timing before any restart (§5.2), in whole CHOMP samples."""
+        out = []
+        previous = seq.initial_pose
+        for k, step in enumerate(seq.steps):
+            pose = step.swing_pose
+            before = keyframe_at(self.wb, step.stance_before, previous.base_pos, previous.rpy)
+            shift = np.stack([before.q, pose.q])
+            spline = SwingSpline.plan(
+                step.start,
+                step.target,
+                1.0,
+                self.config.swing,
+                self.terrain,
+                self.robot.foot_radius,
+            )
+            path = spline.position(np.linspace(0.0, 1.0, 41))
+            legs_b = np.repeat(
+                ((pose.feet - pose.base_pos) @ pose.rotation)[None], len(path), axis=0
+            )
+            legs_b[:, step.leg] = (path - pose.base_pos) @ pose.rotation
+            q, _ = self.wb.inverse_kinematics(legs_b)
+            timing = step_timing(
+                shift,
+                q[:, step.leg],
+                self.wb.velocity_limit,
+                self.config.timing,
+                step.leg,
+                settle=k == len(seq.steps) - 1,
+            )
+            out.append(timing.quantized(self.dt))
+            previous = pose
+        return out
+
+    def shortcut_poses(self, seq: StepSequence) -> list[BodyKeyframe | None]:
+        """Footnote 2: per step, the shortcut swing pose, or None where no shorter or unsafe."""
+        if not self.config.zmp.shortcut:
+            return [None] * len(seq)
+        anchors = seq.anchors()
+        out: list[BodyKeyframe | None] = []
+        cm = self.wb.collision
+        need = self.config.validity.min_clearance
+        for k, step in enumerate(seq.steps):
+            a = anchors[k + 1]
+            p = shortcut_anchor(
+                anchors[k], a, anchors[k + 2], step.support_triangle, self.config.zmp.support_margin
+            )
+            if float(np.linalg.norm(p - a)) < 1e-4:
+                out.append(None)
+                continue
+            pose = step.swing_pose.translated(self.wb, np.array([p[0] - a[0], p[1] - a[1], 0.0]))
+            d = capsule_clearances(
+                self.wb,
+                self.sdf,
+                pose.q[None],
+                pose.base_pos[None],
+                pose.rotation[None],
+            )[0]
+            safe = bool(np.all(pose.reachable)) and bool(np.all(d[~cm.is_foot] >= need))
+            out.append(pose if safe else None)
+        return out
+
+    # ---- one footstep ---------------------------------------------------------------
+
+    def optimize(self, state: FootstepState) -> OptimizationOutcome:
+        """CHOMP on one footstep: trunk, then swing leg, until valid or out of iterations."""
+        cfg = self.config.chomp
+        validity = self.config.validity
+        obstacle = ObstacleCost(
+            self.sdf, self.wb.points.radius, cfg.obstacle_epsilon, cfg.obstacle_weight, cfg.gradient
+        )
+        body_reference = state.body[1:-1].copy()
+        swing_reference = state.q[state.lift_off + 1 : state.touchdown, state.step.leg].copy()
+        total = 0
+        status = ChompStatus.ITERATION_LIMIT
+        while True:
+            body = BodyPass(
+                self.wb, state, obstacle, cfg, validity, self.config.zmp.gravity, body_reference
+            )
+            chomp = Chomp(
+                body.smoothness,
+                body.evaluate,
+                step_size=cfg.step_size,
+                max_step=cfg.max_step,
+                line_search=cfg.line_search,
+            )
+            # A zero budget still evaluates: the initial trajectory may be valid as it is.
+            res = chomp.optimize(
+                state.body[1:-1], min(cfg.body_iterations, cfg.max_iterations - total)
+            )
+            total += res.iterations
+            body.apply(res.xi)
+            if res.status == ChompStatus.VALID:
+                return OptimizationOutcome(total, ChompStatus.VALID)
+            budget = min(cfg.swing_iterations, cfg.max_iterations - total)
+            if budget <= 0:
+                break
+            swing = SwingPass(
+                self.wb,
+                state,
+                self.sdf,
+                cfg,
+                validity,
+                rest_feasible=body.feasible_without_leg(state.step.leg),
+                reference=swing_reference,
+            )
+            chomp = Chomp(
+                swing.smoothness,
+                swing.evaluate,
+                step_size=cfg.step_size,
+                max_step=cfg.max_step,
+                line_search=cfg.line_search,
+                project=swing.project,
+            )
+            res2 = chomp.optimize(swing.initial, budget)
+            total += res2.iterations
+            swing.apply(res2.xi)
+            if res2.status == ChompStatus.VALID:
+                return OptimizationOutcome(total, ChompStatus.VALID)
+            if res.iterations == 0 and res2.iterations == 0:
+                status = ChompStatus.CONVERGED
+                break
+            if total >= cfg.max_iterations:
+                break
+        return OptimizationOutcome(total, status)
+
+    def _window(
+        self,
+        k: int,
+        start: StartState,
+        timing: StepTiming,
+        anchor: NDArray[np.float64],
+        anchors: NDArray[np.float64],
+        timings: list[StepTiming],
+        n_steps: int,
+    ) -> tuple[NDArray[np.float64], int]:
+        """ZMP reference samples over the preview window from step k, and its length N."""
+        last = min(k + self.config.zmp.preview_steps, n_steps)
+        window = [timing] + timings[k + 1 : last]
+        points = [start.zmp_anchor, anchor, *anchors[k + 2 : last + 1]]
+        if last == n_steps:
+            points.append(anchors[n_steps + 1])
+        ref = ZmpReference.through_anchors(np.array(points), window, start.time)
+        total = sum(t.duration_s for t in window)
+        m = int(round(total / self.dt))
+        samples = ref.sample(start.time + self.dt * np.arange(m + 1))
+        return samples, m
+
+    def prepare(self, plan: Any) -> PreparedPlan:
+        """Read a plan and do the per-plan work: timings, shortcut poses, ZMP anchors."""
+        seq = self.sequence(plan)
+        timings = self.nominal_timings(seq)
+        shortcuts = self.shortcut_poses(seq)
+        anchors = seq.anchors()
+        for k, pose in enumerate(shortcuts):
+            if pose is not None:
+                anchors[k + 1] = pose.com[:2]
+        init = seq.initial_pose
+        start = StartState(
+            time=0.0,
+            base_pos=init.base_pos,
+            rpy=init.rpy,
+            com_state=np.array([init.com[:2], [0.0, 0.0], [0.0, 0.0]]),
+            com_offset=init.com_offset,
+            zmp_anchor=init.com[:2].copy(),
+        )
+        return PreparedPlan(seq, timings, shortcuts, anchors, start)
+
+    def initial_state(
+        self,
+        prepared: PreparedPlan,
+        k: int,
+        start: StartState,
+        use_shortcut: bool = False,
+        scale: float = 1.0,
+    ) -> FootstepState:
+        """The initial trajectory of step k (0-based) from ``start`` (§5.2), before CHOMP.
+
+        ``use_shortcut`` takes the footnote-2 pose where there is one;
+        ``scale`` lengthens the step (a restart).
+        """
+        step = prepared.sequence.steps[k]
+        shortcut = prepared.shortcuts[k]
+        pose = shortcut if use_shortcut and shortcut is not None else step.swing_pose
+        timing = prepared.timings[k].scaled(scale).quantized(self.dt)
+        anchor = pose.com[:2].copy()
+        reference, horizon = self._window(
+            k, start, timing, anchor, prepared.anchors, prepared.timings, len(prepared.sequence)
+        )
+        support_z = float(np.mean(step.support_triangle[:, 2]))
+        return build_initial_trajectory(
+            self.wb,
+            step,
+            start,
+            pose,
+            timing,
+            self.dt,
+            self.controller(float(pose.com[2]) - support_z),
+            reference,
+            horizon,
+            self.config.swing,
+            self.terrain,
+            end_pose=step.end_pose if timing.settle_s > 0 else None,
+            used_shortcut=use_shortcut and shortcut is not None,
+        )
+
+    def iter_steps(self, plan: Any) -> Iterator[FootstepTrajectory]:
+        """Yield the footsteps' trajectories in order, each as soon as it is ready."""
+        prepared = plan if isinstance(plan, PreparedPlan) else self.prepare(plan)
+        cfg = self.config
+        start = prepared.start
+        factor = cfg.chomp.restart_duration_factor
+        for k in range(len(prepared.sequence)):
+            began = time.perf_counter()
+            # The shortcut first where it exists, then the certificate, then longer steps (§5.3).
+            plans: list[tuple[bool, float]] = []
+            if prepared.shortcuts[k] is not None:
+                plans.append((True, 1.0))
+            while len(plans) < cfg.chomp.max_restarts + 1:
+                n_cert = sum(1 for s, _ in plans if not s)
+                plans.append((False, factor**n_cert))
+            result: FootstepTrajectory | None = None
+            state: FootstepState | None = None
+            for attempt, (use_shortcut, scale) in enumerate(plans, start=1):
+                timing = prepared.timings[k].scaled(scale)
+                if timing.shift_s + timing.swing_s > cfg.timing.max_step_s and attempt > 1:
+                    break
+                state = self.initial_state(prepared, k, start, use_shortcut, scale)
+                initial = capsule_clearances(
+                    self.wb, self.sdf, state.q, state.body[:, :3], state.rotation
+                )
+                initial_min = float(initial[:, ~self.wb.collision.is_foot].min())
+                outcome = self.optimize(state)
+                result = resample_footstep(
+                    state,
+                    self.wb,
+                    self.sdf,
+                    cfg,
+                    optimize_ms=(time.perf_counter() - began) * 1000.0,
+                    attempts=attempt,
+                    iterations=outcome.iterations,
+                    initial_min_clearance=initial_min,
+                    chomp_status=outcome.status.value,
+                )
+                if result.valid:
+                    break
+            assert result is not None and state is not None
+            yield result
+            settled = state.timing.settle_s > 0
+            last_anchor = prepared.anchors[-1] if settled else state.anchor
+            start = StartState(
+                time=float(state.times[-1]),
+                base_pos=state.body[-1, :3].copy(),
+                rpy=state.body[-1, 3:].copy(),
+                com_state=state.preview.final_state,
+                com_offset=state.com_offset[-1].copy(),
+                zmp_anchor=np.asarray(last_anchor, dtype=float).copy(),
+            )

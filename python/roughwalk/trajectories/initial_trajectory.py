@@ -1,0 +1,261 @@
+"""The initial whole-body trajectory of one footstep (Zucker 2011, §5.2).
+
+The CoM comes from the ZMP preview controller, the trunk's height and
+orientation (and the CoM's offset from the trunk) from splines between the
+keyframe poses, the swing foot from its spline, and every leg's joint angles
+from IK; all sampled at CHOMP's fixed rate. "Note that although the
+trajectory satisfies the 2D dynamic stability criteria, it may be infeasible
+in other respects: there could be kinematic reachability issues, or
+collisions against the terrain." CHOMP corrects those next.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roughwalk.trajectories.body_keyframes import BodyKeyframe
+from roughwalk.trajectories.body_spline import BodySpline
+from roughwalk.trajectories.config import SwingConfig
+from roughwalk.trajectories.euler import rpy_to_matrix
+from roughwalk.trajectories.step_sequence import StepSpec
+from roughwalk.trajectories.support_polygon import convex_polygon
+from roughwalk.trajectories.swing_spline import SwingSpline
+from roughwalk.trajectories.timing import StepTiming
+from roughwalk.trajectories.whole_body import WholeBody
+from roughwalk.trajectories.zmp_preview import PreviewRun, ZmpPreviewController
+
+if TYPE_CHECKING:
+    from roughwalk.terrain.terrain import Terrain
+
+__all__ = ["StartState", "FootstepState", "build_initial_trajectory", "SHIFT", "SWING", "SETTLE"]
+
+SHIFT, SWING, SETTLE = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class StartState:
+    """Where a footstep starts: time [s], trunk pose, CoM state, and the ZMP anchor it holds.
+
+    ``com_state`` (3, 2) is the preview controller's CoM position, velocity
+    and acceleration per horizontal axis; ``com_offset`` (3,) [m] the CoM
+    minus the trunk position the previous step ended with.
+    """
+
+    time: float
+    base_pos: NDArray[np.float64]
+    rpy: NDArray[np.float64]
+    com_state: NDArray[np.float64]
+    com_offset: NDArray[np.float64]
+    zmp_anchor: NDArray[np.float64]
+
+
+@dataclass
+class FootstepState:
+    """One footstep's trajectory at CHOMP's rate while it is built and optimised.
+
+    Arrays have one row per sample t = 0 … T − 1, both ends included (the
+    ends are fixed). ``body`` (T, 6) is (x, y, z, roll, pitch, yaw) of the
+    trunk [m, rad]; ``q`` (T, 4, 3) canonical joint angles [rad]; ``feet``
+    (T, 4, 3) foot targets [m] (the swing foot's spline while airborne);
+    ``support`` (T, 4) which feet bear weight; ``phase`` (T,) SHIFT, SWING
+    or SETTLE. ``lift_off`` and ``touchdown`` index the swing's end samples.
+    """
+
+    step: StepSpec
+    timing: StepTiming
+    dt: float
+    times: NDArray[np.float64]
+    phase: NDArray[np.int64]
+    support: NDArray[np.bool_]
+    feet: NDArray[np.float64]
+    body: NDArray[np.float64]
+    q: NDArray[np.float64]
+    reached: NDArray[np.bool_]
+    com_offset: NDArray[np.float64]
+    com_offset_acceleration: NDArray[np.float64]
+    preview: PreviewRun
+    zmp_reference: NDArray[np.float64]
+    com_height: float
+    lift_off: int
+    touchdown: int
+    swing: SwingSpline
+    anchor: NDArray[np.float64]
+    used_shortcut: bool
+    polygons: list[NDArray[np.float64]] = field(default_factory=list)
+    polygon_index: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    end_rates: NDArray[np.float64] = field(default_factory=lambda: np.zeros((2, 6)))
+    """Trunk rates (x, y, z, roll, pitch, yaw per second) at the first and last sample:
+    the CoM's from the preview controller, the rest from the keyframe spline."""
+
+    @property
+    def n_samples(self) -> int:
+        """T."""
+        return int(self.times.shape[0])
+
+    @property
+    def rotation(self) -> NDArray[np.float64]:
+        """(T, 3, 3) trunk orientations."""
+        return rpy_to_matrix(self.body[:, 3:])
+
+    def solve_legs(self, wb: WholeBody, legs: NDArray[np.bool_] | None = None) -> None:
+        """Re-solve IK for the feet marked in ``legs`` (T, 4) (default: the supporting ones)."""
+        mask = self.support if legs is None else legs
+        rot = self.rotation
+        feet_b = np.einsum("tji,tlj->tli", rot, self.feet - self.body[:, None, :3])
+        q, reached = wb.inverse_kinematics(feet_b)
+        self.q = np.where(mask[..., None], q, self.q)
+        self.reached = np.where(mask, reached, self.reached)
+
+
+def _unwrap_to(angle: float, reference: float) -> float:
+    return reference + math.remainder(angle - reference, 2 * math.pi)
+
+
+def build_initial_trajectory(
+    wb: WholeBody,
+    step: StepSpec,
+    start: StartState,
+    swing_pose: BodyKeyframe,
+    timing: StepTiming,
+    dt: float,
+    controller: ZmpPreviewController,
+    reference: NDArray[np.float64],
+    preview_samples: int,
+    swing_config: SwingConfig,
+    terrain: Terrain | None,
+    *,
+    end_pose: BodyKeyframe | None = None,
+    used_shortcut: bool = False,
+) -> FootstepState:
+    """Assemble the footstep's initial trajectory.
+
+    Parameters
+    ----------
+    wb:
+        The robot's batched kinematics.
+    step:
+        The footstep.
+    start:
+        Its start (the previous step's end).
+    swing_pose:
+        The keyframe held through the swing (the certificate, or its
+        shortcut translation); its CoM is the ZMP anchor.
+    timing:
+        Phase durations, whole multiples of ``dt``.
+    dt:
+        Sample period [s].
+    controller:
+        The ZMP preview controller for this step's CoM height.
+    reference:
+        (M, 2) ZMP reference [m] at t = start.time + i·dt over the preview
+        window (this step and the next ones).
+    preview_samples:
+        The preview horizon N.
+    swing_config, terrain:
+        For the swing foot's lift-off and drop-off points.
+    end_pose:
+        With a settling phase: the pose to settle into.
+    used_shortcut:
+        Recorded in the result.
+    """
+    n_shift, n_swing, n_settle = timing.samples(dt)
+    n = n_shift + n_swing + n_settle
+    t0 = start.time
+    times = t0 + dt * np.arange(n + 1, dtype=np.float64)
+    lift_off, touchdown = n_shift, n_shift + n_swing
+
+    # Trunk height, orientation and CoM offset: smoothstep between keyframes (§5.2).
+    rpy_swing = swing_pose.rpy.copy()
+    rpy_swing[2] = _unwrap_to(rpy_swing[2], float(start.rpy[2]))
+    knots = [t0, times[lift_off], times[touchdown]]
+    values = [
+        np.concatenate([[start.base_pos[2]], start.rpy, start.com_offset]),
+        np.concatenate([[swing_pose.base_pos[2]], rpy_swing, swing_pose.com_offset]),
+    ]
+    values.append(values[-1])
+    if n_settle and end_pose is not None:
+        rpy_end = end_pose.rpy.copy()
+        rpy_end[2] = _unwrap_to(rpy_end[2], float(rpy_swing[2]))
+        knots.append(times[-1])
+        values.append(np.concatenate([[end_pose.base_pos[2]], rpy_end, end_pose.com_offset]))
+    spline = BodySpline(np.array(knots), np.array(values))
+    pose, pose_rate, pose_acc = spline.evaluate(times)
+    offset = pose[:, 4:7]
+
+    run = controller.run(reference, n, start.com_state, preview=preview_samples)
+    body = np.empty((n + 1, 6))
+    body[:, :2] = run.com - offset[:, :2]
+    body[:, 2] = pose[:, 0]
+    body[:, 3:] = pose[:, 1:4]
+
+    swing = SwingSpline.plan(
+        step.start,
+        step.target,
+        n_swing * dt,
+        swing_config,
+        terrain=terrain,
+        foot_radius=wb.robot.foot_radius,
+    )
+    feet = np.repeat(step.stance_before[None], n + 1, axis=0)
+    feet[lift_off : touchdown + 1, step.leg] = swing.position(
+        times[lift_off : touchdown + 1] - times[lift_off]
+    )
+    feet[touchdown:, step.leg] = step.target
+    support = np.ones((n + 1, 4), dtype=bool)
+    support[lift_off + 1 : touchdown, step.leg] = False
+    phase = np.full(n + 1, SHIFT, dtype=np.int64)
+    phase[lift_off:touchdown] = SWING
+    phase[touchdown:] = SETTLE if n_settle else SWING
+    if not n_settle:
+        phase[-1] = SWING
+
+    polygons = [
+        convex_polygon(step.stance_before),
+        convex_polygon(step.support_triangle),
+        convex_polygon(step.stance_after),
+    ]
+    polygon_index = np.zeros(n + 1, dtype=np.int64)
+    polygon_index[lift_off + 1 : touchdown] = 1
+    polygon_index[touchdown:] = 2
+
+    support_z = float(np.mean(step.support_triangle[:, 2]))
+    state = FootstepState(
+        step=step,
+        timing=timing,
+        dt=dt,
+        times=times,
+        phase=phase,
+        support=support,
+        feet=feet,
+        body=body,
+        q=np.zeros((n + 1, 4, 3)),
+        reached=np.ones((n + 1, 4), dtype=bool),
+        com_offset=offset,
+        com_offset_acceleration=pose_acc[:, 4:7],
+        preview=run,
+        zmp_reference=np.asarray(reference, dtype=float)[: n + 1]
+        if reference.shape[0] >= n + 1
+        else np.concatenate(
+            [reference, np.repeat(reference[-1:], n + 1 - reference.shape[0], axis=0)]
+        ),
+        com_height=max(float(swing_pose.com[2]) - support_z, 1e-3),
+        lift_off=lift_off,
+        touchdown=touchdown,
+        swing=swing,
+        anchor=swing_pose.com[:2].copy(),
+        used_shortcut=used_shortcut,
+        polygons=polygons,
+        polygon_index=polygon_index,
+    )
+    rates = np.empty((2, 6))
+    for row, k in ((0, 0), (1, n)):
+        rates[row, :2] = run.com_velocity[k] - pose_rate[k, 4:6]
+        rates[row, 2:] = pose_rate[k, :4]
+    state.end_rates = rates
+    state.solve_legs(wb, np.ones((n + 1, 4), dtype=bool))
+    return state

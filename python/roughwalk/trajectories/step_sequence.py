@@ -1,0 +1,278 @@
+"""A footstep plan read into what trajectory generation needs: steps and keyframes.
+
+Accepts the footstep planner's :class:`FootstepPlan` or its JSON (``roughwalk
+plan``): ``footsteps`` [{leg, x, y, z}] in execution order starting with the
+four feet of the initial stance, and ``certificates`` [{step, base_pos,
+base_quat, q}], one per footstep after the initial stance: the pose holding
+the stance that step reaches with the CoM inside the support triangle of the
+next step (Zucker 2011, §4.3). Missing pieces are filled as a certificate
+search would start them (:func:`pose_over_support`): the initial pose, the
+pose for the first step, certificates of a bare footstep list.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roughwalk.errors import InvalidArgumentError, PlanningError
+from roughwalk.robots.canonical_frame import LEG_NAMES
+from roughwalk.trajectories.body_keyframes import (
+    BodyKeyframe,
+    keyframe_at,
+    nominal_fit,
+    pose_over_support,
+    rpy_of,
+)
+from roughwalk.trajectories.whole_body import WholeBody
+
+__all__ = ["StepSpec", "StepSequence", "plan_fields"]
+
+
+@dataclass(frozen=True)
+class StepSpec:
+    """One footstep: leg ``leg`` (canonical index) moves from ``start`` to ``target`` [m].
+
+    ``index`` counts footsteps from 1; ``stance_before`` and ``stance_after``
+    are the four feet (4, 3) [m] around it; ``swing_pose`` is the keyframe
+    held through its swing (CoM inside the triangle of the other three
+    feet) and ``end_pose`` the certificate reached after it.
+    """
+
+    index: int
+    leg: int
+    start: NDArray[np.float64]
+    target: NDArray[np.float64]
+    stance_before: NDArray[np.float64]
+    stance_after: NDArray[np.float64]
+    swing_pose: BodyKeyframe
+    end_pose: BodyKeyframe
+
+    @property
+    def leg_name(self) -> str:
+        """The swing leg's name: LF, RF, LH or RH."""
+        return LEG_NAMES[self.leg]
+
+    @property
+    def support_legs(self) -> tuple[int, ...]:
+        """The three legs that stay down."""
+        return tuple(i for i in range(4) if i != self.leg)
+
+    @property
+    def support_triangle(self) -> NDArray[np.float64]:
+        """(3, 3) feet of the support legs [m]."""
+        return self.stance_before[list(self.support_legs)]
+
+
+def _get(obj: Any, name: str, default: Any = None) -> Any:
+    if isinstance(obj, Mapping):
+        return obj.get(name, default)
+    return getattr(obj, name, default)
+
+
+def plan_fields(plan: Any) -> dict[str, Any]:
+    """The plan's robot, terrain, footsteps, certificates and initial pose, from any form.
+
+    ``plan`` is a :class:`FootstepPlan`-like object, its JSON dict (the
+    fields may be nested under ``"plan"``), or a path to that JSON.
+    """
+    if isinstance(plan, str | Path):
+        p = Path(plan)
+        try:
+            plan = json.loads(p.read_text())
+        except (OSError, json.JSONDecodeError) as e:
+            raise PlanningError(f"cannot read footstep plan '{p}': {e}") from None
+    if (
+        isinstance(plan, Mapping)
+        and "footsteps" not in plan
+        and isinstance(plan.get("plan"), Mapping)
+    ):
+        inner = dict(plan["plan"])
+        for key in ("robot", "terrain"):
+            inner.setdefault(key, plan.get(key))
+        plan = inner
+    footsteps = _get(plan, "footsteps")
+    if footsteps is None:
+        raise PlanningError(
+            "a footstep plan needs 'footsteps' ([{leg, x, y, z}], initial stance first); "
+            f"got {type(plan).__name__} without them"
+        )
+    robot = _get(plan, "robot")
+    terrain = _get(plan, "terrain")
+    return {
+        "robot": robot if isinstance(robot, str) or robot is None else _get(robot, "name", robot),
+        "terrain": terrain
+        if isinstance(terrain, str) or terrain is None
+        else _get(terrain, "spec", terrain),
+        "footsteps": list(footsteps),
+        "certificates": list(_get(plan, "certificates", None) or []),
+        "initial_pose": _get(plan, "initial_pose", None),
+    }
+
+
+def _leg_index(value: Any, where: str) -> int:
+    if isinstance(value, str) and value.upper() in LEG_NAMES:
+        return LEG_NAMES.index(value.upper())
+    if isinstance(value, int | np.integer) and 0 <= int(value) < 4:
+        return int(value)
+    raise PlanningError(f"{where}: leg {value!r} is not one of {', '.join(LEG_NAMES)} (or 0–3)")
+
+
+def _footstep(entry: Any, where: str) -> tuple[int, NDArray[np.float64]]:
+    leg = _leg_index(_get(entry, "leg"), where)
+    pos = _get(entry, "position")
+    if pos is None:
+        pos = [_get(entry, k) for k in ("x", "y", "z")]
+    try:
+        p = np.asarray(pos, dtype=float)
+    except (TypeError, ValueError):
+        raise PlanningError(f"{where}: position must be three numbers [m], got {pos!r}") from None
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise PlanningError(f"{where}: position must be three finite numbers [m], got {pos!r}")
+    return leg, p
+
+
+def _pose(entry: Any, where: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    try:
+        pos = np.asarray(_get(entry, "base_pos"), dtype=float)
+        quat = np.asarray(_get(entry, "base_quat"), dtype=float)
+    except (TypeError, ValueError):
+        raise PlanningError(f"{where}: base_pos and base_quat must be numbers") from None
+    if (
+        pos.shape != (3,)
+        or quat.shape != (4,)
+        or not np.all(np.isfinite(pos))
+        or not (np.all(np.isfinite(quat)) and np.linalg.norm(quat) > 1e-9)
+    ):
+        raise PlanningError(
+            f"{where}: needs base_pos [x, y, z] and a nonzero base_quat [w, x, y, z], "
+            f"got {pos.tolist()} and {quat.tolist()}"
+        )
+    return pos, rpy_of(quat)
+
+
+class StepSequence:
+    """The footsteps of a plan with a keyframe for every swing and every step's end.
+
+    Build with :meth:`from_plan`.
+    """
+
+    def __init__(
+        self,
+        wb: WholeBody,
+        initial_stance: NDArray[np.float64],
+        initial_pose: BodyKeyframe,
+        steps: Sequence[StepSpec],
+    ) -> None:
+        self.wb = wb
+        self.initial_stance = initial_stance
+        self.initial_pose = initial_pose
+        self.steps = list(steps)
+
+    def __len__(self) -> int:
+        return len(self.steps)
+
+    @classmethod
+    def from_plan(cls, plan: Any, wb: WholeBody, support_margin: float = 0.015) -> StepSequence:
+        """Read ``plan`` (see :func:`plan_fields`) for the robot of ``wb``.
+
+        ``support_margin`` [m] is the CoM margin of the keyframes made here
+        (the initial stance's swing pose and missing certificates).
+        """
+        fields = plan_fields(plan)
+        entries = fields["footsteps"]
+        if len(entries) < 5:
+            raise PlanningError(
+                f"a footstep plan needs the 4 feet of its initial stance and at least one step; "
+                f"got {len(entries)} footsteps"
+            )
+        stance = np.full((4, 3), np.nan)
+        for i, entry in enumerate(entries[:4]):
+            leg, pos = _footstep(entry, f"footsteps[{i}]")
+            if np.all(np.isfinite(stance[leg])):
+                raise PlanningError(
+                    f"footsteps[{i}]: leg {LEG_NAMES[leg]} appears twice in the initial stance"
+                )
+            stance[leg] = pos
+        moves = [_footstep(e, f"footsteps[{i}]") for i, e in enumerate(entries[4:], start=4)]
+        certs = fields["certificates"]
+        if certs and len(certs) != len(moves):
+            raise PlanningError(
+                f"the plan has {len(moves)} steps but {len(certs)} certificates; "
+                "expected one per step after the initial stance"
+            )
+        if certs and all(_get(c, "step") is not None for c in certs):
+            certs = sorted(certs, key=lambda c: int(_get(c, "step")))
+
+        init = fields["initial_pose"]
+        if init is not None:
+            pos, rpy = _pose(init, "initial_pose")
+            initial = keyframe_at(wb, stance, pos, rpy)
+        else:
+            base, rpy = nominal_fit(wb, stance)
+            initial = keyframe_at(wb, stance, base, rpy)
+
+        steps: list[StepSpec] = []
+        before = stance
+        swing_pose: BodyKeyframe | None = None
+        for k, (leg, target) in enumerate(moves):
+            after = before.copy()
+            after[leg] = target
+            support = [i for i in range(4) if i != leg]
+            if swing_pose is None:
+                swing_pose = pose_over_support(
+                    wb, before, support, support_margin, start=(initial.base_pos, initial.rpy)
+                )
+            if certs:
+                pos, rpy = _pose(certs[k], f"certificates[{k}]")
+                end = keyframe_at(wb, after, pos, rpy)
+            else:
+                following = (
+                    [i for i in range(4) if i != moves[k + 1][0]]
+                    if k + 1 < len(moves)
+                    else list(range(4))
+                )
+                end = pose_over_support(
+                    wb,
+                    after,
+                    following,
+                    support_margin,
+                    start=(swing_pose.base_pos, swing_pose.rpy),
+                )
+            steps.append(
+                StepSpec(
+                    index=k + 1,
+                    leg=leg,
+                    start=before[leg].copy(),
+                    target=target,
+                    stance_before=before,
+                    stance_after=after,
+                    swing_pose=swing_pose,
+                    end_pose=end,
+                )
+            )
+            before = after
+            swing_pose = end
+        return cls(wb, stance, initial, steps)
+
+    def anchors(self) -> NDArray[np.float64]:
+        """ZMP anchors (S + 2, 2) [m]: initial CoM, each swing pose's CoM, the final CoM."""
+        pts = [self.initial_pose.com[:2]]
+        pts += [s.swing_pose.com[:2] for s in self.steps]
+        pts.append(self.steps[-1].end_pose.com[:2])
+        return np.array(pts)
+
+
+def check_step_range(sequence: StepSequence, first: int, count: int | None) -> range:
+    """Step indices (0-based) from ``first``, ``count`` of them (all when None)."""
+    n = len(sequence)
+    if not (0 <= first < n):
+        raise InvalidArgumentError(f"first step {first} is outside the plan's steps 0…{n - 1}")
+    stop = n if count is None else min(n, first + max(int(count), 0))
+    return range(first, stop)

@@ -1,0 +1,153 @@
+"""The swing foot's initial path (Zucker 2011, §5.2).
+
+"For the swing leg, a spline is constructed to move smoothly from initial
+foot position, up to a heuristically determined 'liftoff' position, over to a
+'dropoff' position, and down to the footstep target." Here the pieces are
+quintic Hermite segments through the four waypoints with zero acceleration at
+every waypoint (so the path is C², and starts and ends at rest), velocities
+at the interior waypoints chosen per coordinate as Fritsch–Carlson do for
+monotone cubics (zero where the path turns) and capped at twice the slope of
+either neighbouring segment, which keeps these quintics monotone too, and
+waypoint times proportional to segment lengths.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from roughwalk.errors import InvalidArgumentError
+from roughwalk.trajectories.config import SwingConfig
+
+if TYPE_CHECKING:
+    from roughwalk.terrain.terrain import Terrain
+
+__all__ = ["SwingSpline"]
+
+
+def _interior_slopes(
+    points: NDArray[np.float64], times: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Velocities (K, 3) at the waypoints: zero at the ends, monotone-preserving inside."""
+    h = np.diff(times)
+    delta = np.diff(points, axis=0) / h[:, None]
+    v = np.zeros_like(points)
+    for i in range(1, len(points) - 1):
+        d0, d1 = delta[i - 1], delta[i]
+        w1 = 2 * h[i] + h[i - 1]
+        w2 = h[i] + 2 * h[i - 1]
+        same = d0 * d1 > 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            harmonic = (w1 + w2) / (w1 / d0 + w2 / d1)
+        # A zero-acceleration quintic stays monotone while |v| ≤ 2·|slope|.
+        cap = 2.0 * np.minimum(np.abs(d0), np.abs(d1))
+        v[i] = np.where(same, np.clip(harmonic, -cap, cap), 0.0)
+    return v
+
+
+class SwingSpline:
+    """A C² foot path through start, lift-off, drop-off and target, at rest at both ends.
+
+    Parameters
+    ----------
+    waypoints:
+        (K, 3) positions [m], K ≥ 2: start, ..., target.
+    duration:
+        Time [s] from start to target.
+    """
+
+    def __init__(self, waypoints: ArrayLike, duration: float) -> None:
+        p = np.asarray(waypoints, dtype=float)
+        if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 2 or not np.all(np.isfinite(p)):
+            raise InvalidArgumentError(f"swing waypoints must be finite (K ≥ 2, 3), got {p.shape}")
+        if not (np.isfinite(duration) and duration > 0):
+            raise InvalidArgumentError(f"swing duration must be positive [s], got {duration}")
+        seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
+        # Chord-length timing, but no segment gets less than a tenth of the
+        # average, so a short one (a tiny stride) is not a dash.
+        seg = np.maximum(seg, 0.1 * seg.mean() + 1e-9)
+        self.waypoints = p
+        self.duration = float(duration)
+        self.times = np.concatenate([[0.0], np.cumsum(seg) / seg.sum() * duration])
+        self.velocities = _interior_slopes(p, self.times)
+
+    @classmethod
+    def plan(
+        cls,
+        start: ArrayLike,
+        target: ArrayLike,
+        duration: float,
+        config: SwingConfig,
+        terrain: Terrain | None = None,
+        foot_radius: float = 0.0,
+    ) -> SwingSpline:
+        """The heuristic lift-off and drop-off points, then the spline.
+
+        Both sit at one height: ``lift_height`` above the higher of start and
+        target, and with ``scan_terrain``, ``clearance`` above the highest
+        terrain under the straight path (foot sphere included, sampled across
+        the foot's width). They are ``lift_fraction`` of the stride in from
+        start and target.
+        """
+        s = np.asarray(start, dtype=float)
+        t = np.asarray(target, dtype=float)
+        top = max(s[2], t[2]) + config.lift_height
+        if config.scan_terrain and terrain is not None:
+            stride = float(np.linalg.norm(t[:2] - s[:2]))
+            n = max(8, int(np.ceil(stride / 0.005)) + 1)
+            along = np.linspace(0.0, 1.0, n)[:, None] * (t[:2] - s[:2]) + s[:2]
+            if stride > 1e-9:
+                side = np.array([-(t[1] - s[1]), t[0] - s[0]]) / stride
+            else:
+                side = np.array([0.0, 1.0])
+            xy = np.concatenate([along + k * foot_radius * side for k in (-1.0, 0.0, 1.0)])
+            ground = float(np.max(terrain.height(xy)))
+            top = max(top, ground + foot_radius + config.clearance)
+        f = config.lift_fraction
+        lift = s + f * (t - s)
+        drop = t - f * (t - s)
+        lift[2] = drop[2] = top
+        return cls(np.array([s, lift, drop, t]), duration)
+
+    def _segments(
+        self, t: ArrayLike
+    ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]]:
+        tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
+        i = np.clip(np.searchsorted(self.times, tt, side="right") - 1, 0, len(self.times) - 2)
+        h = self.times[i + 1] - self.times[i]
+        return i, (tt - self.times[i]) / h, h
+
+    def evaluate(
+        self, t: ArrayLike
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """Position [m], velocity [m/s] and acceleration [m/s²], each (n, 3), at times t [s].
+
+        Times outside [0, duration] are clamped (the foot rests at its ends).
+        """
+        i, s, h = self._segments(t)
+        s = s[:, None]
+        h = h[:, None]
+        p0, p1 = self.waypoints[i], self.waypoints[i + 1]
+        v0, v1 = self.velocities[i] * h, self.velocities[i + 1] * h
+        s2, s3 = s * s, s * s * s
+        # Quintic Hermite basis with zero end accelerations.
+        h00 = 1 - 10 * s3 + 15 * s3 * s - 6 * s3 * s2
+        h10 = s - 6 * s3 + 8 * s3 * s - 3 * s3 * s2
+        h11 = -4 * s3 + 7 * s3 * s - 3 * s3 * s2
+        h01 = 10 * s3 - 15 * s3 * s + 6 * s3 * s2
+        d00 = -30 * s2 + 60 * s3 - 30 * s3 * s
+        d10 = 1 - 18 * s2 + 32 * s3 - 15 * s3 * s
+        d11 = -12 * s2 + 28 * s3 - 15 * s3 * s
+        a00 = -60 * s + 180 * s2 - 120 * s3
+        a10 = -36 * s + 96 * s2 - 60 * s3
+        a11 = -24 * s + 84 * s2 - 60 * s3
+        pos = h00 * p0 + h10 * v0 + h11 * v1 + h01 * p1
+        vel = (d00 * p0 + d10 * v0 + d11 * v1 - d00 * p1) / h
+        acc = (a00 * p0 + a10 * v0 + a11 * v1 - a00 * p1) / (h * h)
+        return pos, vel, acc
+
+    def position(self, t: ArrayLike) -> NDArray[np.float64]:
+        """Foot positions (n, 3) [m] at times t [s]."""
+        return self.evaluate(t)[0]

@@ -1,0 +1,141 @@
+"""Step timing (Zucker 2011, §5.2), the swing foot spline and the trunk keyframe spline."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import roughwalk as rw
+from roughwalk.errors import ConfigError, InvalidArgumentError
+from roughwalk.trajectories.body_spline import BodySpline
+from roughwalk.trajectories.config import SwingConfig, TimingConfig, TrajectoryConfig
+from roughwalk.trajectories.swing_spline import SwingSpline
+from roughwalk.trajectories.timing import StepTiming, min_joint_time, min_profile_time, step_timing
+
+
+def test_min_joint_time_is_the_slowest_joint() -> None:
+    path = np.array([[0.0, 0.0], [0.3, -0.7], [0.6, 0.0]])
+    # Joint 0 travels 0.6 rad at 3 rad/s (0.2 s); joint 1 travels 1.4 rad at 14 rad/s (0.1 s).
+    assert min_joint_time(path, [3.0, 14.0]) == pytest.approx(0.2)
+    assert min_joint_time(path, [3.0, np.inf]) == pytest.approx(0.2)
+    with pytest.raises(InvalidArgumentError):
+        min_joint_time(path, [3.0])
+
+
+def test_min_profile_time_scales_the_peak_speed_to_the_limit() -> None:
+    s = np.linspace(0.0, 1.0, 101)
+    profile = np.stack(
+        [np.sin(np.pi * s), 0.5 * s], axis=1
+    )  # peak rates π and 0.5 rad per unit time
+    t = min_profile_time(profile, [7.5, 14.0])
+    assert t == pytest.approx(np.pi / 7.5, rel=1e-3)
+
+
+def test_step_timing_applies_margins_and_floors() -> None:
+    limits = np.full((4, 3), 10.0)
+    shift = np.zeros((2, 4, 3))
+    shift[1, 0, 1] = 1.0  # 0.1 s at the limit
+    swing = np.stack([np.linspace(0, 3.0, 41)] * 3, axis=1)  # 3 rad in unit time: 0.3 s
+    cfg = TimingConfig(
+        velocity_margin=2.0, swing_velocity_margin=1.5, min_shift_s=0.05, min_swing_s=0.1
+    )
+    timing = step_timing(shift, swing, limits, cfg, swing_leg=0)
+    assert timing.shift_s == pytest.approx(0.2)
+    assert timing.swing_s == pytest.approx(0.45)
+    slow = step_timing(np.zeros((2, 4, 3)), np.zeros((41, 3)), limits, cfg, 0, settle=True)
+    assert (slow.shift_s, slow.swing_s, slow.settle_s) == (0.05, 0.1, cfg.settle_s)
+    quantized = StepTiming(0.21, 0.33, 0.0).quantized(0.02)
+    assert quantized.samples(0.02) == (11, 17, 0)
+    assert StepTiming(0.21, 0.33).scaled(1.3).swing_s == pytest.approx(0.429)
+    with pytest.raises(ConfigError, match="velocity_margin"):
+        TimingConfig(velocity_margin=0.5)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    st.floats(-0.02, 0.03),
+    st.floats(0.0, 0.12),
+    st.floats(-0.03, 0.03),
+    st.floats(0.2, 1.0),
+    st.floats(0.0, 0.4),
+)
+def test_swing_spline_is_smooth_and_rests_at_both_ends(
+    dz: float, stride: float, dy: float, duration: float, lift_fraction: float
+) -> None:
+    start = np.array([0.1, 0.05, 0.01])
+    target = start + [stride, dy, dz]
+    spline = SwingSpline.plan(
+        start, target, duration, SwingConfig(lift_height=0.03, lift_fraction=lift_fraction)
+    )
+    t = np.linspace(0.0, duration, 801)
+    pos, vel, acc = spline.evaluate(t)
+    np.testing.assert_allclose(pos[0], start, atol=1e-12)
+    np.testing.assert_allclose(pos[-1], target, atol=1e-12)
+    np.testing.assert_allclose(vel[[0, -1]], 0.0, atol=1e-12)
+    np.testing.assert_allclose(acc[[0, -1]], 0.0, atol=1e-9)
+    # Passes its lift-off and drop-off points at their times.
+    np.testing.assert_allclose(spline.position(spline.times), spline.waypoints, atol=1e-12)
+    # Velocity and acceleration are the derivatives of the path ...
+    h = 1e-6
+    inner = t[1:-1]
+    p_plus, v_plus, _ = spline.evaluate(inner + h)
+    p_minus, v_minus, _ = spline.evaluate(inner - h)
+    np.testing.assert_allclose((p_plus - p_minus) / (2 * h), vel[1:-1], atol=1e-6)
+    np.testing.assert_allclose(
+        (v_plus - v_minus) / (2 * h), acc[1:-1], atol=1e-4 * max(1.0, np.abs(acc).max())
+    )
+    # ... and continuous across the waypoints (C²): jumps no bigger than the jerk allows.
+    jerk = np.abs(np.diff(acc, axis=0)).max() / (t[1] - t[0])
+    for tk in spline.times[1:-1]:
+        before = spline.evaluate([tk - 1e-9])
+        after = spline.evaluate([tk + 1e-9])
+        for a, b in zip(before, after, strict=True):
+            np.testing.assert_allclose(a, b, atol=4e-9 * jerk + 1e-12)
+    # It never swings backward or overshoots sideways, and peaks at the lift height.
+    along = (pos[:, :2] - start[:2]) @ (target[:2] - start[:2])
+    assert np.all(np.diff(along) >= -1e-12)
+    assert pos[:, 2].max() == pytest.approx(max(start[2], target[2]) + 0.03, abs=1e-9)
+    assert pos[:, 2].min() >= min(start[2], target[2]) - 1e-12
+
+
+def test_swing_spline_clears_the_terrain_it_scans() -> None:
+    terrain = rw.load_terrain("barrier:height=0.06,thickness=0.02,center=1.0")
+    start, target = np.array([0.96, 0.0, 0.0103]), np.array([1.05, 0.0, 0.0103])
+    cfg = SwingConfig(lift_height=0.01, clearance=0.02, lift_fraction=0.0)
+    spline = SwingSpline.plan(start, target, 0.5, cfg, terrain=terrain, foot_radius=0.0103)
+    assert spline.waypoints[1, 2] == pytest.approx(0.06 + 0.0103 + 0.02, abs=1e-6)
+    pos = spline.position(np.linspace(0, 0.5, 400))
+    over = (pos[:, 0] > 0.99 - 0.0103) & (pos[:, 0] < 1.01 + 0.0103)
+    assert pos[over, 2].min() > 0.06 + 0.0103
+
+
+def test_body_spline_holds_and_blends_keyframes() -> None:
+    spline = BodySpline([0.0, 0.3, 0.7, 1.0], [[0.0, 1.0], [1.0, 2.0], [1.0, 2.0], [0.0, 0.0]])
+    t = np.linspace(-0.1, 1.1, 1201)
+    v, d, dd = spline.evaluate(t)
+    np.testing.assert_allclose(
+        spline.value([0.0, 0.3, 0.5, 0.7, 1.0]), [[0, 1], [1, 2], [1, 2], [1, 2], [0, 0]]
+    )
+    np.testing.assert_allclose(v[t < 0], [[0.0, 1.0]] * int((t < 0).sum()))
+    h = 1e-6
+    plus, minus = spline.evaluate(t + h), spline.evaluate(t - h)
+    np.testing.assert_allclose((plus[0] - minus[0]) / (2 * h), d, atol=1e-6)
+    np.testing.assert_allclose((plus[1] - minus[1]) / (2 * h), dd, atol=3e-3)  # C², not C³
+    # At rest at every keyframe.
+    np.testing.assert_allclose(spline.evaluate([0.3, 0.7])[1], 0.0, atol=1e-12)
+    with pytest.raises(InvalidArgumentError):
+        BodySpline([0.0, 0.0], [[0.0], [1.0]])
+
+
+def test_config_refuses_nonsense() -> None:
+    with pytest.raises(ConfigError, match="chomp.smoothness_order"):
+        rw.trajectories.trajectory_config(**{"chomp.smoothness_order": 3})
+    with pytest.raises(ConfigError, match="unknown config field"):
+        rw.trajectories.trajectory_config(**{"chomp.nonsense": 3})
+    cfg = rw.trajectories.trajectory_config(
+        chomp={"max_iterations": 7}, **{"zmp.shortcut": "false"}
+    )
+    assert cfg.chomp.max_iterations == 7 and cfg.zmp.shortcut is False
+    assert isinstance(cfg, TrajectoryConfig)

@@ -1,0 +1,135 @@
+"""ZMP preview control (Kajita 2003) and the ZMP reference of Zucker 2011, §5.2."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from roughwalk.errors import InvalidArgumentError
+from roughwalk.trajectories.timing import StepTiming
+from roughwalk.trajectories.zmp_preview import ZmpPreviewController
+from roughwalk.trajectories.zmp_reference import (
+    ZmpReference,
+    inside_triangle,
+    shortcut_anchor,
+    shrink_triangle,
+)
+
+DT = 0.02
+
+
+def _crawl_reference() -> tuple[ZmpReference, list[StepTiming]]:
+    anchors = np.array(
+        [
+            [0.0, 0.0],
+            [0.01, 0.02],
+            [0.03, -0.015],
+            [0.045, 0.02],
+            [0.06, -0.02],
+            [0.07, 0.0],
+            [0.07, 0.0],
+        ]
+    )
+    timings = [StepTiming(0.3, 0.4)] * 4 + [StepTiming(0.3, 0.4, settle_s=1.6)]
+    # The cart stands still for 0.6 s first: preview control needs warning of a move.
+    return ZmpReference.through_anchors(anchors, timings, start_time=0.6), timings
+
+
+def test_riccati_solution_and_gains() -> None:
+    c = ZmpPreviewController(0.17, DT)
+    a, b = c.A, c.B
+    q = c.C.T @ c.C
+    p = c.P
+    g = np.linalg.inv(1e-6 + b.T @ p @ b)
+    residual = a.T @ p @ a - a.T @ p @ b @ g @ b.T @ p @ a + q - p
+    assert np.abs(residual).max() < 1e-6 * np.abs(p).max()
+    assert np.all(np.abs(np.linalg.eigvals(a - b @ c.K[None])) < 1)  # stable closed loop
+    # A ZMP held at rest must keep the cart at rest: Σ f_j = K·(1, 0, 0).
+    assert c.preview_gains(400).sum() == pytest.approx(c.K[0], rel=1e-9)
+
+
+def test_preview_tracks_the_reference_and_starts_and_ends_at_rest() -> None:
+    ref, _ = _crawl_reference()
+    t = np.arange(0.0, ref.end_time + 1e-9, DT)
+    samples = ref.sample(t)
+    c = ZmpPreviewController(0.17, DT)
+    run = c.run(samples, len(t) - 1, preview=75)
+    # Starts at rest on the reference; the preview begins moving it by jerk only.
+    np.testing.assert_allclose(run.com[0], samples[0])
+    np.testing.assert_allclose(run.com_velocity[0], 0.0)
+    np.testing.assert_allclose(run.com_acceleration[0], 0.0)
+    err = np.linalg.norm(run.zmp - samples, axis=1)
+    assert err.max() < 0.004
+    assert np.sqrt(np.mean(err**2)) < 0.001
+    # Ends at rest over the last anchor after the settling phase.
+    assert np.linalg.norm(run.com[-1] - samples[-1]) < 1e-3
+    assert np.linalg.norm(run.com_velocity[-1]) < 5e-3
+    assert np.linalg.norm(run.com_acceleration[-1]) < 5e-2
+    # Its ZMP is the cart-table's: c − (z_c/g)·c̈.
+    np.testing.assert_allclose(run.zmp, run.com - 0.17 / 9.81 * run.com_acceleration, atol=1e-12)
+
+
+def test_preview_improves_with_a_longer_window() -> None:
+    ref, _ = _crawl_reference()
+    t = np.arange(0.0, ref.end_time + 1e-9, DT)
+    samples = ref.sample(t)
+    c = ZmpPreviewController(0.17, DT)
+    errors = [
+        np.abs(c.run(samples, len(t) - 1, preview=n).zmp - samples).max() for n in (2, 10, 75)
+    ]
+    assert errors[0] > errors[1] > errors[2]
+
+
+def test_a_run_continues_where_the_last_one_stopped() -> None:
+    ref, _ = _crawl_reference()
+    t = np.arange(0.0, ref.end_time + 1e-9, DT)
+    samples = ref.sample(t)
+    c = ZmpPreviewController(0.17, DT)
+    whole = c.run(samples, 60, preview=50)
+    first = c.run(samples, 25, preview=50)
+    second = c.run(samples[25:], 35, first.final_state, preview=50)
+    np.testing.assert_allclose(second.com, whole.com[25:], atol=1e-12)
+
+
+def test_reference_through_anchors_shifts_then_holds() -> None:
+    ref, timings = _crawl_reference()
+    # During the swing of step 2 the reference holds anchor 2; mid-shift it is halfway.
+    t_swing = 0.6 + timings[0].duration_s + timings[1].shift_s + 0.2
+    np.testing.assert_allclose(ref.sample([t_swing])[0], [0.03, -0.015])
+    t_mid = 0.6 + timings[0].duration_s + timings[1].shift_s / 2
+    np.testing.assert_allclose(ref.sample([t_mid])[0], [0.02, 0.0025])
+    with pytest.raises(InvalidArgumentError, match="anchors"):
+        ZmpReference.through_anchors(np.zeros((3, 2)), timings)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10_000))
+def test_shortcut_is_inside_the_shrunk_triangle_and_never_longer(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    tri = rng.uniform(-0.1, 0.1, (3, 2))
+    inner = shrink_triangle(tri, 0.01)
+    centre = inner.mean(axis=0)
+    prev, nxt = rng.uniform(-0.15, 0.15, (2, 2))
+    p = shortcut_anchor(prev, centre, nxt, tri, 0.01)
+    assert inside_triangle(p[None], inner, tol=1e-9)[0]
+
+    def length(x: np.ndarray) -> float:
+        return float(np.linalg.norm(x - prev) + np.linalg.norm(x - nxt))
+
+    assert length(p) <= length(centre) + 1e-12
+    # Brute force over a dense grid of the shrunk triangle: nothing much shorter.
+    w = rng.dirichlet(np.ones(3), 4000)
+    grid = w @ inner
+    best = min(length(g) for g in grid)
+    assert length(p) <= best + 2e-3
+
+
+def test_shrunk_triangle_keeps_the_margin() -> None:
+    tri = np.array([[0.0, 0.0], [0.2, 0.0], [0.0, 0.1]])
+    inner = shrink_triangle(tri, 0.01)
+    from roughwalk.trajectories.support_polygon import convex_polygon, polygon_margin
+
+    margins, _ = polygon_margin(inner, convex_polygon(tri))
+    np.testing.assert_allclose(margins, 0.01, atol=1e-12)
