@@ -93,6 +93,8 @@ class SdfField:
     @property
     def shape(self) -> tuple[int, int, int]: ...
 
+def feature_transform(seeds: NDArray[np.bool_]) -> NDArray[np.int64]: ...
+
 # ---- robot kinematics (crates/roughwalk-py/src/robot.rs) ----
 
 class LegChain:

@@ -539,3 +539,26 @@ def test_mesh_terrain_with_an_arch_matches_brute_force() -> None:
     assert np.all(np.sign(got[far]) == np.sign(exact[far]))
     err = np.abs(got - exact)
     assert err.max() <= 0.5 * math.sqrt(3) * sdf.resolution, f"{err.max()} at {p[np.argmax(err)]}"
+
+
+def test_rust_feature_transform_finds_a_nearest_seed_like_scipy() -> None:
+    from scipy import ndimage
+
+    from roughwalk import _core
+
+    rng = np.random.default_rng(11)
+    for shape, density in (
+        ((7, 5, 9), 0.05),
+        ((30, 20, 25), 0.002),
+        ((4, 4, 4), 0.5),
+        ((9, 1, 6), 0.2),
+    ):
+        seeds = rng.random(shape) < density
+        seeds.flat[rng.integers(seeds.size)] = True
+        nearest = _core.feature_transform(seeds)
+        assert seeds.flat[nearest.ravel()].all(), "every answer is a seed"
+        ours = np.linalg.norm(
+            np.stack(np.unravel_index(nearest, shape)) - np.indices(shape), axis=0
+        )
+        np.testing.assert_allclose(ours, ndimage.distance_transform_edt(~seeds), atol=1e-12)
+    assert (_core.feature_transform(np.zeros((3, 4, 5), dtype=bool)) == -1).all()

@@ -12,6 +12,7 @@ use numpy::{
     PyReadonlyArray3, PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
+use roughwalk_core::sdf::edt::NO_SEED;
 use roughwalk_core::sdf::{
     Band, DistanceGrid, GridSpec, HeightFieldDistance, SignedDistanceField, TriangleMesh,
 };
@@ -346,8 +347,40 @@ impl PySdfField {
     }
 }
 
+/// Felzenszwalb–Huttenlocher feature transform of a 3-D boolean array:
+/// for every voxel, the C-order linear index of a Euclidean-nearest True
+/// voxel (−1 everywhere if there is none).
+#[pyfunction]
+fn feature_transform<'py>(
+    py: Python<'py>,
+    seeds: PyReadonlyArray3<'py, bool>,
+) -> PyResult<Bound<'py, PyArray3<i64>>> {
+    let s = seeds.shape();
+    let shape = [s[0], s[1], s[2]];
+    let n = shape[0] * shape[1] * shape[2];
+    if n >= u32::MAX as usize {
+        return Err(invalid(format!(
+            "feature_transform: {n} voxels is more than {} allowed",
+            u32::MAX - 1
+        )));
+    }
+    let mut labels: Vec<u32> = seeds
+        .as_array()
+        .iter()
+        .enumerate()
+        .map(|(i, &b)| if b { i as u32 } else { NO_SEED })
+        .collect();
+    py.detach(|| roughwalk_core::sdf::edt::feature_transform(shape, &mut labels));
+    let out: Vec<i64> = labels
+        .into_iter()
+        .map(|l| if l == NO_SEED { -1 } else { i64::from(l) })
+        .collect();
+    out.into_pyarray(py).reshape(shape)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PySdfBand>()?;
     m.add_class::<PySdfField>()?;
+    m.add_function(wrap_pyfunction!(feature_transform, m)?)?;
     Ok(())
 }

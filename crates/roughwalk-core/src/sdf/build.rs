@@ -7,9 +7,14 @@
 //!    surface gets its exact distance and closest surface point.
 //! 3. Far voxels: a feature transform seeded by the band voxels names each
 //!    far voxel's nearest band voxel; the far voxel's distance is measured to
-//!    that band voxel's exact closest surface point, which is nearly exact
-//!    (far more so than the EDT's distance to a voxel centre), and its sign
-//!    comes from occupancy.
+//!    that band voxel's exact closest surface point (far closer to the truth
+//!    than the EDT's distance to a voxel centre), then improved: line sweeps
+//!    pass better closest points along y and z, the x neighbours are tried,
+//!    and, for height fields, one Newton step onto the tangent plane and the
+//!    point straight below are tried too. The result is an upper bound on
+//!    |distance| that is nearly exact and, above all, smooth enough for
+//!    gradients (without the Newton step, gradient norms over gentle terrain
+//!    wander by ±10 %; with it, by ±2 %). The sign comes from occupancy.
 //!
 //! [`Band`] holds the state after step 2, so that step 3 can run on the
 //! Rust feature transform or on one computed elsewhere (scipy, `edt`).
