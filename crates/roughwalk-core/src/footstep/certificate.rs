@@ -1,0 +1,577 @@
+//! Pose certificates (Zucker 2011, §4.3–4.4): a full 18-DOF configuration
+//! that puts the feet on their footholds, keeps the centre of mass over the
+//! support triangle and the body (feet excluded) clear of the terrain.
+//!
+//! The search starts from a trunk pose guessed from the feet and, for at
+//! most `max_iterations` rounds, adds up the corrections the pose still
+//! needs: the reachability step (§3.2) for legs IK cannot place, a
+//! horizontal nudge of the centre of mass into the triangle, and the
+//! obstacle-avoidance step (§3.4) at the point of least clearance; it stops
+//! with a certificate when none is needed.
+//!
+//! Which triangle: the three feet that stay down during the NEXT step, so
+//! that the pose holding this stance lets the next leg lift. The start
+//! stance is certified the same way.
+
+use crate::footstep::collision::{Clearance, CollisionModel};
+use crate::footstep::config::CertificateConfig;
+use crate::footstep::mass_model::MassModel;
+use crate::kinematics::body_pose::point_pose_jacobians;
+use crate::kinematics::leg::LinkFrames;
+use crate::kinematics::math::{
+    add, cross, det, exp_so3, mat_mul, mat_t_vec, mat_to_quat, mat_vec, norm, scale, sub, Mat3,
+    Quat, Vec3,
+};
+use crate::kinematics::quadruped::{BodyPose, Quadruped};
+use crate::kinematics::support::support_triangle_incircle;
+use crate::sdf::SignedDistanceField;
+
+/// A point in the x–y plane [m].
+pub type Vec2 = [f64; 2];
+
+/// The CoM correction aims this far past the margin [m], so that the next
+/// round finds no correction to make.
+const COM_AIM: f64 = 5e-4;
+
+/// A certified whole-body pose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PoseCertificate {
+    /// Trunk (base frame) origin [m].
+    pub base_pos: Vec3,
+    /// Trunk orientation (w, x, y, z).
+    pub base_quat: Quat,
+    /// Joint angles [rad], canonical leg-major order.
+    pub q: [f64; 12],
+    /// Correction rounds it took (1: the guessed pose needed none).
+    pub iterations: u32,
+    /// Whole-body centre of mass [m].
+    pub com: Vec3,
+    /// Its distance inside the support triangle [m].
+    pub com_margin: f64,
+    /// Least body clearance [m] as the distance field measures it, less the
+    /// field's error bound; capped at `preferred_clearance` (it is at least that).
+    pub clearance: f64,
+    /// Least normalised foot-Jacobian volume over the legs (1 far from
+    /// singular, 0 singular).
+    pub singularity: f64,
+    /// Singularity and clearance penalties (Zucker 2011, §4.3) [cost].
+    pub penalty: f64,
+}
+
+/// What the last round still had to correct when the search gave up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CertificateFailure {
+    /// A foot was out of reach (or past a joint limit).
+    Unreachable,
+    /// The centre of mass was outside the support triangle's margin.
+    CenterOfMass,
+    /// The body was closer to the terrain than the clearance.
+    Collision,
+}
+
+impl CertificateFailure {
+    /// A short reason.
+    pub fn describe(self) -> &'static str {
+        match self {
+            CertificateFailure::Unreachable => "a foot is out of reach",
+            CertificateFailure::CenterOfMass => {
+                "the centre of mass cannot be kept over the support triangle"
+            }
+            CertificateFailure::Collision => "the body cannot be kept clear of the terrain",
+        }
+    }
+}
+
+/// Signed distance [m] of `p` inside the triangle `tri` (positive inside):
+/// the least signed distance to its edge lines.
+pub fn triangle_margin(p: Vec2, tri: &[Vec2; 3]) -> f64 {
+    let area2 = (tri[1][0] - tri[0][0]) * (tri[2][1] - tri[0][1])
+        - (tri[1][1] - tri[0][1]) * (tri[2][0] - tri[0][0]);
+    let orient = if area2 >= 0.0 { 1.0 } else { -1.0 };
+    let mut m = f64::INFINITY;
+    for k in 0..3 {
+        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+        let e = [b[0] - a[0], b[1] - a[1]];
+        let len = e[0].hypot(e[1]);
+        if len == 0.0 {
+            return f64::NEG_INFINITY;
+        }
+        let side = orient * (e[0] * (p[1] - a[1]) - e[1] * (p[0] - a[0])) / len;
+        m = m.min(side);
+    }
+    m
+}
+
+fn closest_on_segment(p: Vec2, a: Vec2, b: Vec2) -> Vec2 {
+    let ab = [b[0] - a[0], b[1] - a[1]];
+    let l2 = ab[0] * ab[0] + ab[1] * ab[1];
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    [a[0] + t * ab[0], a[1] + t * ab[1]]
+}
+
+/// The point at least `margin` [m] inside every edge of `tri` that is
+/// closest to `p`; the incircle centre when no point keeps that margin.
+///
+/// The points with that margin form the triangle shrunk about the incircle
+/// centre by (r − margin)/r, so this is a closest point on a triangle.
+pub fn closest_point_in_triangle(p: Vec2, tri: &[Vec2; 3], margin: f64) -> Vec2 {
+    let (centre, r) = support_triangle_incircle(tri[0], tri[1], tri[2]);
+    if r <= margin {
+        return centre;
+    }
+    let s = (r - margin) / r;
+    let inner = tri.map(|v| {
+        [
+            centre[0] + s * (v[0] - centre[0]),
+            centre[1] + s * (v[1] - centre[1]),
+        ]
+    });
+    if triangle_margin(p, &inner) >= 0.0 {
+        return p;
+    }
+    let mut best = (f64::INFINITY, p);
+    for k in 0..3 {
+        let c = closest_on_segment(p, inner[k], inner[(k + 1) % 3]);
+        let d = (c[0] - p[0]).hypot(c[1] - p[1]);
+        if d < best.0 {
+            best = (d, c);
+        }
+    }
+    best.1
+}
+
+/// |det J| / (|J₀|·|J₁|·|J₂|) of a 3×3 Jacobian (columns J_k): 1 for
+/// orthogonal columns, 0 at a singularity.
+fn normalised_volume(j: &Mat3) -> f64 {
+    let col = |k: usize| [j[0][k], j[1][k], j[2][k]];
+    let lengths = norm(col(0)) * norm(col(1)) * norm(col(2));
+    if lengths > 0.0 {
+        (det(j).abs() / lengths).min(1.0)
+    } else {
+        0.0
+    }
+}
+
+/// Foot Jacobian ∂f_B/∂q from a leg's link frames and its foot point.
+fn foot_jacobian(frames: &LinkFrames, foot: Vec3) -> Mat3 {
+    let c = |k: usize| cross(frames.axis[k], sub(foot, frames.anchor[k]));
+    let (c0, c1, c2) = (c(0), c(1), c(2));
+    [
+        [c0[0], c1[0], c2[0]],
+        [c0[1], c1[1], c2[1]],
+        [c0[2], c1[2], c2[2]],
+    ]
+}
+
+fn rot_z(a: f64) -> Mat3 {
+    let (s, c) = a.sin_cos();
+    [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+}
+
+fn rot_y(a: f64) -> Mat3 {
+    let (s, c) = a.sin_cos();
+    [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]
+}
+
+fn rot_x(a: f64) -> Mat3 {
+    let (s, c) = a.sin_cos();
+    [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]
+}
+
+/// Everything a certificate search needs about the robot and the terrain.
+#[derive(Debug, Clone)]
+pub struct CertificateSearch<'a> {
+    /// The legs.
+    pub robot: &'a Quadruped,
+    /// Link masses.
+    pub mass: &'a MassModel,
+    /// The body's capsules (no feet).
+    pub collision: &'a CollisionModel,
+    /// The terrain.
+    pub sdf: &'a SignedDistanceField,
+    /// Step sizes, margins and penalties.
+    pub config: &'a CertificateConfig,
+    /// Height of the trunk origin over the feet's mean contact height at the
+    /// nominal stance [m].
+    pub nominal_height: f64,
+    /// Centroid of the nominal stance's feet in the base frame (x, y) [m].
+    pub nominal_feet_centroid: Vec2,
+    /// Centre of mass in the base frame at the nominal joint angles [m].
+    pub nominal_com: Vec3,
+    /// Bound on the distance field's interpolation error [m], added to every
+    /// clearance it is asked to certify.
+    pub sdf_error: f64,
+}
+
+impl CertificateSearch<'_> {
+    /// The trunk pose guessed from the footholds: over the feet's centroid at
+    /// the nominal height above their mean contact height, facing `heading`
+    /// [rad], tilted like the feet (clamped to `max_tilt`), and shifted so
+    /// that the nominal centre of mass sits over the support triangle.
+    pub fn initial_pose(
+        &self,
+        contacts: &[Vec3; 4],
+        support: &[usize; 3],
+        heading: f64,
+    ) -> BodyPose {
+        let mid = |a: usize, b: usize| {
+            [
+                0.5 * (contacts[a][0] + contacts[b][0]),
+                0.5 * (contacts[a][1] + contacts[b][1]),
+                0.5 * (contacts[a][2] + contacts[b][2]),
+            ]
+        };
+        let (front, hind, left, right) = (mid(0, 1), mid(2, 3), mid(0, 2), mid(1, 3));
+        let tilt = |high: Vec3, low: Vec3| {
+            let run = (high[0] - low[0]).hypot(high[1] - low[1]).max(1e-9);
+            (high[2] - low[2])
+                .atan2(run)
+                .clamp(-self.config.max_tilt, self.config.max_tilt)
+        };
+        // Ry(pitch) with pitch > 0 lowers the nose; Rx(roll) > 0 raises the left side.
+        let pitch = -tilt(front, hind);
+        let roll = tilt(left, right);
+        let r = mat_mul(&rot_z(heading), &mat_mul(&rot_y(pitch), &rot_x(roll)));
+        let n = 0.25;
+        let centroid = contacts.iter().fold([0.0; 3], |s, c| add(s, scale(*c, n)));
+        let offset = mat_vec(
+            &r,
+            [
+                self.nominal_feet_centroid[0],
+                self.nominal_feet_centroid[1],
+                0.0,
+            ],
+        );
+        let mut x = [
+            centroid[0] - offset[0],
+            centroid[1] - offset[1],
+            centroid[2] + self.nominal_height,
+        ];
+        let com = add(x, mat_vec(&r, self.nominal_com));
+        let tri = support.map(|leg| [contacts[leg][0], contacts[leg][1]]);
+        let target =
+            closest_point_in_triangle([com[0], com[1]], &tri, self.config.com_margin + COM_AIM);
+        x[0] += target[0] - com[0];
+        x[1] += target[1] - com[1];
+        BodyPose { x, r }
+    }
+
+    /// Searches for a certificate of the stance whose foot centres are
+    /// `feet` [m] and contact points `contacts` [m] (canonical order), with
+    /// the centre of mass over the triangle of the legs `support`.
+    pub fn find(
+        &self,
+        feet: &[Vec3; 4],
+        contacts: &[Vec3; 4],
+        support: &[usize; 3],
+        heading: f64,
+    ) -> Result<PoseCertificate, CertificateFailure> {
+        let cfg = self.config;
+        let legs = self.robot.legs();
+        let tri = support.map(|leg| [contacts[leg][0], contacts[leg][1]]);
+        let required = cfg.clearance + self.sdf_error;
+        let cutoff = required.max(cfg.preferred_clearance + self.sdf_error);
+        let spacing = self.sdf.grid().spec().resolution;
+        let mut pose = self.initial_pose(contacts, support, heading);
+        let mut failure = CertificateFailure::Unreachable;
+        for iteration in 1..=cfg.max_iterations {
+            let mut dx = [0.0; 3];
+            let mut omega = [0.0; 3];
+            let mut q = [0.0; 12];
+            let mut reachable = true;
+            let mut frames = [LinkFrames {
+                pos: [[0.0; 3]; 3],
+                rot: [[[0.0; 3]; 3]; 3],
+                anchor: [[0.0; 3]; 3],
+                axis: [[0.0; 3]; 3],
+            }; 4];
+            for (i, leg) in legs.iter().enumerate() {
+                let ik = leg.ik(pose.to_body(feet[i]), None);
+                q[3 * i..3 * i + 3].copy_from_slice(&ik.q);
+                frames[i] = leg.link_frames(ik.q);
+                if !ik.reachable {
+                    // Zucker 2011, §3.2: a virtual force at the reachable foot toward its target.
+                    reachable = false;
+                    let f_b = add(
+                        frames[i].pos[2],
+                        mat_vec(&frames[i].rot[2], leg.params().foot),
+                    );
+                    let reached = pose.to_world(f_b);
+                    let e = sub(feet[i], reached);
+                    let len = norm(e);
+                    let e = if len > 0.0 {
+                        scale(e, 1.0 + cfg.reach_overshoot / len)
+                    } else {
+                        e
+                    };
+                    dx = add(dx, scale(e, cfg.alpha_reach));
+                    omega = add(omega, scale(cross(sub(reached, pose.x), e), cfg.beta_reach));
+                }
+            }
+            let com = add(pose.x, mat_vec(&pose.r, self.mass.com_base(&frames)));
+            let com_margin = triangle_margin([com[0], com[1]], &tri);
+            let com_ok = com_margin >= cfg.com_margin;
+            if !com_ok {
+                let target =
+                    closest_point_in_triangle([com[0], com[1]], &tri, cfg.com_margin + COM_AIM);
+                let mut d = [target[0] - com[0], target[1] - com[1], 0.0];
+                let len = norm(d);
+                if len > cfg.com_max_step {
+                    d = scale(d, cfg.com_max_step / len);
+                }
+                dx = add(dx, d);
+            }
+            let closest = self
+                .collision
+                .closest_below(self.sdf, &pose, &frames, cutoff, spacing);
+            let collision = closest.filter(|c| c.distance < required);
+            if let Some(c) = collision {
+                self.obstacle_step(feet, &pose, &c, required, &mut dx, &mut omega);
+            }
+            if reachable && com_ok && collision.is_none() {
+                return Ok(self.certificate(&pose, q, &frames, com, com_margin, closest, iteration));
+            }
+            failure = if !reachable {
+                CertificateFailure::Unreachable
+            } else if !com_ok {
+                CertificateFailure::CenterOfMass
+            } else {
+                CertificateFailure::Collision
+            };
+            pose = BodyPose {
+                x: add(pose.x, dx),
+                r: mat_mul(&exp_so3(omega), &pose.r),
+            };
+        }
+        Err(failure)
+    }
+
+    /// Zucker 2011, §3.4: Δx = α·J_p(x)ᵀ·g, ω = β·J_p(R)ᵀ·g at the point of
+    /// least clearance, g scaled by how far it must move.
+    fn obstacle_step(
+        &self,
+        feet: &[Vec3; 4],
+        pose: &BodyPose,
+        c: &Clearance,
+        required: f64,
+        dx: &mut Vec3,
+        omega: &mut Vec3,
+    ) {
+        let cfg = self.config;
+        let g_len = norm(c.gradient);
+        if g_len == 0.0 {
+            return;
+        }
+        let g = scale(
+            c.gradient,
+            (required + cfg.clearance_overshoot - c.distance) / g_len,
+        );
+        let Ok(jac) = point_pose_jacobians(self.robot, feet, pose.x, mat_to_quat(&pose.r), c.point)
+        else {
+            return;
+        };
+        *dx = add(*dx, scale(mat_t_vec(&jac.j_x, g), cfg.alpha_obstacle));
+        *omega = add(*omega, scale(mat_t_vec(&jac.j_r, g), cfg.beta_obstacle));
+    }
+
+    fn certificate(
+        &self,
+        pose: &BodyPose,
+        q: [f64; 12],
+        frames: &[LinkFrames; 4],
+        com: Vec3,
+        com_margin: f64,
+        closest: Option<Clearance>,
+        iterations: usize,
+    ) -> PoseCertificate {
+        let cfg = self.config;
+        let mut singularity: f64 = 1.0;
+        let mut penalty = 0.0;
+        for (leg, f) in self.robot.legs().iter().zip(frames) {
+            let foot = add(f.pos[2], mat_vec(&f.rot[2], leg.params().foot));
+            let s = normalised_volume(&foot_jacobian(f, foot));
+            singularity = singularity.min(s);
+            if cfg.singularity_margin > 0.0 {
+                penalty += cfg.singularity_penalty * (1.0 - s / cfg.singularity_margin).max(0.0);
+            }
+        }
+        let clearance = closest.map_or(cfg.preferred_clearance, |c| {
+            (c.distance - self.sdf_error).min(cfg.preferred_clearance)
+        });
+        let band = cfg.preferred_clearance - cfg.clearance;
+        if band > 0.0 {
+            penalty += cfg.clearance_penalty
+                * ((cfg.preferred_clearance - clearance) / band).clamp(0.0, 1.0);
+        }
+        PoseCertificate {
+            base_pos: pose.x,
+            base_quat: mat_to_quat(&pose.r),
+            q,
+            iterations: iterations as u32,
+            com,
+            com_margin,
+            clearance,
+            singularity,
+            penalty,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::footstep::collision::tests::{littledog_capsules, sdf_of};
+    use crate::footstep::config::tests::test_config;
+    use crate::footstep::mass_model::tests::littledog_mass;
+    use crate::kinematics::math::quat_to_mat;
+    use crate::kinematics::quadruped::tests::littledog;
+    use crate::kinematics::support::{closest_point_with_margin, support_polygon_margin};
+    use proptest::prelude::*;
+
+    proptest! {
+        #[test]
+        fn footstep_triangle_helpers_match_the_support_polygon_routines(
+            ax in -1.0..1.0f64, ay in -1.0..1.0f64, bx in -1.0..1.0f64, by in -1.0..1.0f64,
+            cx in -1.0..1.0f64, cy in -1.0..1.0f64, px in -1.5..1.5f64, py in -1.5..1.5f64,
+            margin in 0.0..0.3f64,
+        ) {
+            let tri = [[ax, ay], [bx, by], [cx, cy]];
+            let (_, r) = support_triangle_incircle(tri[0], tri[1], tri[2]);
+            prop_assume!(r > 0.02);
+            let p = [px, py];
+            let reference = support_polygon_margin(p, &tri);
+            let m = triangle_margin(p, &tri);
+            prop_assert_eq!(m >= 0.0, reference >= 0.0);
+            if reference >= 0.0 {
+                prop_assert!((m - reference).abs() < 1e-9, "{} vs {}", m, reference);
+            }
+            let ours = closest_point_in_triangle(p, &tri, margin);
+            let theirs = closest_point_with_margin(p, &tri, margin);
+            prop_assert!((ours[0] - theirs[0]).hypot(ours[1] - theirs[1]) < 1e-9,
+                "{:?} vs {:?}", ours, theirs);
+        }
+    }
+
+    fn stance(
+        height: &impl Fn(f64, f64) -> f64,
+        centre: [f64; 2],
+        heading: f64,
+    ) -> ([Vec3; 4], [Vec3; 4]) {
+        let nominal = [
+            [0.092, 0.06],
+            [0.092, -0.06],
+            [-0.092, 0.06],
+            [-0.092, -0.06],
+        ];
+        let (s, c) = heading.sin_cos();
+        let contacts = nominal.map(|[x, y]| {
+            let (wx, wy) = (centre[0] + c * x - s * y, centre[1] + s * x + c * y);
+            [wx, wy, height(wx, wy)]
+        });
+        let feet = contacts.map(|p| add(p, [0.0, 0.0, 0.0103]));
+        (feet, contacts)
+    }
+
+    #[test]
+    fn footstep_certificate_holds_feet_com_and_clearance() {
+        let height = |x: f64, y: f64| 0.01 * (10.0 * x).sin() * (8.0 * y).cos();
+        let (_, sdf) = sdf_of(height);
+        let robot = littledog();
+        let mass = littledog_mass();
+        let collision = littledog_capsules();
+        let config = test_config().certificate;
+        let search = CertificateSearch {
+            robot: &robot,
+            mass: &mass,
+            collision: &collision,
+            sdf: &sdf,
+            config: &config,
+            nominal_height: 0.1685,
+            nominal_feet_centroid: [0.0, 0.0],
+            nominal_com: [0.0, 0.0, -0.02],
+            sdf_error: 0.5 * 3f64.sqrt() * 0.005,
+        };
+        let (feet, contacts) = stance(&height, [0.3, 0.0], 0.3);
+        for support in [[1, 2, 3], [0, 1, 3]] {
+            let cert = search
+                .find(&feet, &contacts, &support, 0.3)
+                .expect("certifiable stance");
+            let pose = BodyPose {
+                x: cert.base_pos,
+                r: quat_to_mat(cert.base_quat),
+            };
+            let reached = robot
+                .foot_positions_world(cert.base_pos, cert.base_quat, &cert.q)
+                .unwrap();
+            for i in 0..4 {
+                assert!(norm(sub(reached[i], feet[i])) < 1e-9);
+            }
+            let tri = support.map(|l| [contacts[l][0], contacts[l][1]]);
+            assert!(triangle_margin([cert.com[0], cert.com[1]], &tri) >= config.com_margin);
+            let frames: [LinkFrames; 4] = std::array::from_fn(|i| {
+                robot.legs()[i].link_frames([cert.q[3 * i], cert.q[3 * i + 1], cert.q[3 * i + 2]])
+            });
+            let com = add(pose.x, mat_vec(&pose.r, mass.com_base(&frames)));
+            assert!(norm(sub(com, cert.com)) < 1e-12);
+            assert!(cert.clearance >= config.clearance);
+            assert!(cert.penalty >= 0.0 && cert.singularity > 0.0 && cert.singularity <= 1.0);
+        }
+        // Feet spread beyond the legs' reach: no certificate.
+        let mut far = feet;
+        far[0][0] += 0.4;
+        let mut far_contacts = contacts;
+        far_contacts[0][0] += 0.4;
+        assert_eq!(
+            search.find(&far, &far_contacts, &[1, 2, 3], 0.3),
+            Err(CertificateFailure::Unreachable)
+        );
+    }
+
+    #[test]
+    fn footstep_certificate_lifts_the_body_off_a_bump_under_the_trunk() {
+        // A 13 cm mound under the trunk, which the guessed pose's knees and
+        // trunk touch: the obstacle step must lift the body clear.
+        let height = |x: f64, y: f64| {
+            let r2 = (x - 0.3).powi(2) + y.powi(2);
+            (0.2 - 30.0 * r2).clamp(0.0, 0.13)
+        };
+        let (_, sdf) = sdf_of(height);
+        let robot = littledog();
+        let mass = littledog_mass();
+        let collision = littledog_capsules();
+        let config = test_config().certificate;
+        let search = CertificateSearch {
+            robot: &robot,
+            mass: &mass,
+            collision: &collision,
+            sdf: &sdf,
+            config: &config,
+            nominal_height: 0.1685,
+            nominal_feet_centroid: [0.0, 0.0],
+            nominal_com: [0.0, 0.0, -0.02],
+            sdf_error: 0.0,
+        };
+        let (feet, contacts) = stance(&height, [0.3, 0.0], 0.0);
+        let guess = search.initial_pose(&contacts, &[1, 2, 3], 0.0);
+        let frames: [LinkFrames; 4] = std::array::from_fn(|i| {
+            let ik = robot.legs()[i].ik(guess.to_body(feet[i]), None);
+            robot.legs()[i].link_frames(ik.q)
+        });
+        let before = collision
+            .closest_below(&sdf, &guess, &frames, 1.0, 0.001)
+            .unwrap();
+        assert!(before.distance < config.clearance, "{before:?}");
+        let cert = search
+            .find(&feet, &contacts, &[1, 2, 3], 0.0)
+            .expect("liftable");
+        assert!(
+            cert.iterations > 1 && cert.base_pos[2] > guess.x[2],
+            "{cert:?}"
+        );
+        assert!(cert.clearance >= config.clearance);
+    }
+}
