@@ -32,6 +32,8 @@ class FootstepTrajectories:
         The terrain's spec (rebuilds it with :func:`roughwalk.load_terrain`).
     joint_names:
         The order of the joint columns.
+    joint_velocity_limit:
+        (12,) the robot's joint speed limits [rad/s], same order.
     steps:
         One :class:`FootstepTrajectory` per footstep.
     config:
@@ -43,6 +45,7 @@ class FootstepTrajectories:
     robot: str
     terrain: str | None
     joint_names: tuple[str, ...]
+    joint_velocity_limit: NDArray[np.float64]
     steps: list[FootstepTrajectory]
     config: TrajectoryConfig
     total_ms: float
@@ -164,6 +167,7 @@ def footstep_trajectories(
         robot=robot_obj.name,
         terrain=spec if isinstance(spec, str) else None,
         joint_names=tuple(robot_obj.joint_names),
+        joint_velocity_limit=np.asarray(robot_obj.joint_velocity_limit, dtype=float),
         steps=steps,
         config=cfg,
         total_ms=(time.perf_counter() - began) * 1000.0,

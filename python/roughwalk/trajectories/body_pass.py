@@ -31,9 +31,13 @@ def clearance_ok(
     active: NDArray[np.bool_],
     is_foot: NDArray[np.bool_],
     validity: ValidityConfig,
+    contact_clearance: float = 0.0,
 ) -> bool:
-    """Whether active points (T, U) keep the clearance the validity settings ask for."""
-    need = np.where(is_foot, -validity.foot_tolerance, validity.min_clearance)
+    """Whether active points (T, U) keep the clearance the validity settings ask for.
+
+    ``contact_clearance`` [m] is the lifted foot's clearance on its footholds.
+    """
+    need = np.where(is_foot, validity.foot_floor(contact_clearance), validity.min_clearance)
     return bool(np.all((clearance >= need[None, :]) | ~active))
 
 
@@ -149,8 +153,13 @@ class BodyPass:
         towards = feet_b - self.hips[None]
         dist = np.linalg.norm(towards, axis=-1, keepdims=True)
         pushed = feet_b + self.config.reach_margin * towards / np.maximum(dist, 1e-9)
-        q, _ = self.wb.inverse_kinematics(pushed)
-        error_b = pushed - self.wb.foot_positions(q)
+        q, reached = self.wb.inverse_kinematics(pushed)
+        error_b = np.zeros_like(pushed)
+        # A reached target has no error; forward kinematics only where one is missed.
+        rows = np.flatnonzero(~reached.all(axis=1))
+        if rows.size:
+            error_b[rows] = pushed[rows] - self.wb.foot_positions(q[rows])
+            error_b[rows] *= ~reached[rows][..., None]
         return np.einsum("tij,tlj->tli", rot, error_b)
 
     def evaluate(self, xi: NDArray[np.float64]) -> Evaluation:
@@ -187,7 +196,13 @@ class BodyPass:
         feasible = (
             lost == 0
             and excess == 0.0
-            and clearance_ok(obs.clearance, self.active, self.wb.points.is_foot, self.validity)
+            and clearance_ok(
+                obs.clearance,
+                self.active,
+                self.wb.points.is_foot,
+                self.validity,
+                s.contact_clearance,
+            )
             and bool(np.all(margins >= -self.validity.zmp_tolerance))
         )
         return Evaluation(
@@ -223,7 +238,7 @@ class BodyPass:
         keep = np.arange(4) != leg
         return (
             bool(np.all(reached))
-            and clearance_ok(d, active, self.wb.points.is_foot, self.validity)
+            and clearance_ok(d, active, self.wb.points.is_foot, self.validity, s.contact_clearance)
             and bool(np.all(margins >= -self.validity.zmp_tolerance))
             and velocity_ok(q[:, keep], s.dt, self.wb.velocity_limit[keep])
         )

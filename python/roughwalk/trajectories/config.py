@@ -321,6 +321,15 @@ class ValidityConfig:
     foot_tolerance: float = 0.001
     zmp_tolerance: float = 0.0
 
+    def foot_floor(self, contact_clearance: float = 0.0) -> float:
+        """The least clearance [m] a lifted foot may have.
+
+        ``-foot_tolerance``, or that much below the foot's clearance on its
+        own footholds when the plan put one slightly into the field (a foot
+        cannot do better than the ground it stands on).
+        """
+        return min(-self.foot_tolerance, contact_clearance - self.foot_tolerance)
+
     def __post_init__(self) -> None:
         if not math.isfinite(self.min_clearance):
             raise ConfigError(f"validity.min_clearance must be finite, got {self.min_clearance}")

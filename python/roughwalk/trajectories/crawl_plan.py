@@ -82,8 +82,19 @@ def straight_crawl_plan(
     footprint = robot.nominal_stance.feet[:, :2] * stance_scale
     xy0 = np.asarray(start, dtype=float)[:2]
 
+    # The foot sphere rests on the highest point under it, not on the height at its centre.
+    ring = np.array(
+        [[0.0, 0.0]]
+        + [
+            [rho * np.cos(a), rho * np.sin(a)]
+            for rho in (0.5 * foot_r, foot_r)
+            for a in np.linspace(0.0, 2 * np.pi, 12, endpoint=False)
+        ]
+    )
+    lift = np.sqrt(np.maximum(foot_r**2 - np.sum(ring**2, axis=1), 0.0))
+
     def on_ground(xy: np.ndarray) -> np.ndarray:
-        z = terrain.height(xy[None])[0] + foot_r
+        z = float(np.max(terrain.height(xy[None] + ring) + lift))
         return np.array([xy[0], xy[1], z])
 
     feet = np.array([on_ground(xy0 + rot @ f) for f in footprint])

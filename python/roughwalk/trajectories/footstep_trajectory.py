@@ -186,7 +186,7 @@ def resample_footstep(
 
     clearance_all = capsule_clearances(wb, sdf, q, body[:, :3], rot)
     per_sample, foot_clearance, per_link, collision_free = clearance_summary(
-        wb, clearance_all, support, config.validity
+        wb, clearance_all, support, config.validity, state.contact_clearance
     )
     speed_limit = wb.velocity_limit.reshape(12)
     qd_c = qd.reshape(-1, 12)

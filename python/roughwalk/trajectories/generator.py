@@ -326,7 +326,7 @@ class FootstepTrajectoryGenerator:
             k, start, timing, anchor, prepared.anchors, prepared.timings, len(prepared.sequence)
         )
         support_z = float(np.mean(step.support_triangle[:, 2]))
-        return build_initial_trajectory(
+        state = build_initial_trajectory(
             self.wb,
             step,
             start,
@@ -340,6 +340,38 @@ class FootstepTrajectoryGenerator:
             self.terrain,
             end_pose=step.end_pose if timing.settle_s > 0 else None,
             used_shortcut=use_shortcut and shortcut is not None,
+        )
+        radius = self.wb.collision.radius[
+            self.wb.collision.is_foot & (self.wb.collision.leg == step.leg)
+        ]
+        d, _ = self.sdf.query_spheres(np.array([step.start, step.target]), np.full(2, radius[0]))
+        state.contact_clearance = min(float(np.min(d)), 0.0)
+        return state
+
+    @staticmethod
+    def _worth_restarting(
+        result: FootstepTrajectory, previous: FootstepTrajectory | None, was_shortcut: bool
+    ) -> bool:
+        """Whether another attempt may help (§5.3 restarts on collisions and velocity limits).
+
+        After the shortcut the certificate is always tried. A longer step is
+        tried only while the last one collided or broke a velocity limit, and
+        made progress on that over the attempt before (clearance up by 0.5 mm
+        or the velocity margin up), so hopeless steps are handed on early.
+        """
+        r = result.report
+        if was_shortcut:
+            return True
+        if r.collision_free and r.velocity_limits_ok:
+            return False
+        if previous is None or previous.report.used_shortcut:
+            return True
+        p = previous.report
+        clear_now = min(r.min_clearance_m, r.swing_foot_clearance_m)
+        clear_before = min(p.min_clearance_m, p.swing_foot_clearance_m)
+        return bool(
+            clear_now > clear_before + 5e-4
+            or (not r.velocity_limits_ok and r.velocity_margin_rad_s > p.velocity_margin_rad_s)
         )
 
     def iter_steps(self, plan: Any) -> Iterator[FootstepTrajectory]:
@@ -358,6 +390,7 @@ class FootstepTrajectoryGenerator:
                 n_cert = sum(1 for s, _ in plans if not s)
                 plans.append((False, factor**n_cert))
             result: FootstepTrajectory | None = None
+            previous: FootstepTrajectory | None = None
             state: FootstepState | None = None
             for attempt, (use_shortcut, scale) in enumerate(plans, start=1):
                 timing = prepared.timings[k].scaled(scale)
@@ -380,8 +413,9 @@ class FootstepTrajectoryGenerator:
                     initial_min_clearance=initial_min,
                     chomp_status=outcome.status.value,
                 )
-                if result.valid:
+                if result.valid or not self._worth_restarting(result, previous, use_shortcut):
                     break
+                previous = result
             assert result is not None and state is not None
             yield result
             settled = state.timing.settle_s > 0

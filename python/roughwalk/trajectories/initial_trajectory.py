@@ -88,6 +88,9 @@ class FootstepState:
     used_shortcut: bool
     polygons: list[NDArray[np.float64]] = field(default_factory=list)
     polygon_index: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    contact_clearance: float = 0.0
+    """The swing foot's clearance [m] on its footholds (start and target), ≤ 0 when
+    the plan put one slightly into the terrain's field."""
     end_rates: NDArray[np.float64] = field(default_factory=lambda: np.zeros((2, 6)))
     """Trunk rates (x, y, z, roll, pitch, yaw per second) at the first and last sample:
     the CoM's from the preview controller, the rest from the keyframe spline."""

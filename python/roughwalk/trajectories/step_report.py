@@ -117,14 +117,16 @@ def clearance_summary(
     clearance: NDArray[np.float64],
     support: NDArray[np.bool_],
     validity: ValidityConfig,
+    contact_clearance: float = 0.0,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, float], bool]:
     """Clearances of a footstep's samples from its primitives' clearances (n, P) [m].
 
     Returns the least clearance per sample over the primitives that are not
     feet (n,), the lifted foot's (n,; NaN while all feet are down), the least
     per link, and whether the footstep is collision-free: supporting feet
-    are skipped, a lifted foot may dip ``foot_tolerance`` into the field,
-    every other primitive must keep ``min_clearance``.
+    are skipped, a lifted foot may dip ``foot_tolerance`` into the field
+    (below its footholds' ``contact_clearance`` [m]), every other primitive
+    must keep ``min_clearance``.
     """
     cm = wb.collision
     leg = np.maximum(cm.leg, 0)
@@ -140,6 +142,6 @@ def clearance_summary(
         if np.all(np.isinf(col)):
             continue
         per_link[name] = min(per_link.get(name, np.inf), float(col.min()))
-    need = np.where(cm.is_foot, -validity.foot_tolerance, validity.min_clearance)
+    need = np.where(cm.is_foot, validity.foot_floor(contact_clearance), validity.min_clearance)
     free = bool(np.all(masked >= need[None, :]))
     return body, feet, per_link, free

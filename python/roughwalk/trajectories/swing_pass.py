@@ -128,7 +128,13 @@ class SwingPass:
         feasible = (
             self.rest_feasible
             and excess == 0.0
-            and clearance_ok(obs.clearance, self.active, self.is_foot, self.validity)
+            and clearance_ok(
+                obs.clearance,
+                self.active,
+                self.is_foot,
+                self.validity,
+                self.state.contact_clearance,
+            )
         )
         return Evaluation(
             obs.value + speed_value,

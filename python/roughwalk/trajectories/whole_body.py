@@ -132,6 +132,14 @@ class WholeBody:
         self._axis = np.array([leg.axis for leg in legs])
         self._axis /= np.linalg.norm(self._axis, axis=-1, keepdims=True)
         self._foot = np.array([leg.foot for leg in legs])
+        # Column vectors and the axes' cross-product matrices, for batched matmuls.
+        self._body_pos_col = self._body_pos[..., None]
+        self._anchor_col = self._anchor[..., None]
+        self._axis_col = self._axis[..., None]
+        self._k1 = skew(self._axis)
+        self._k2 = self._k1 @ self._k1
+        self._k1_anchor = self._k1 @ self._anchor_col
+        self._k2_anchor = self._k2 @ self._anchor_col
         self.lower = np.array([leg.lower for leg in legs])
         self.upper = np.array([leg.upper for leg in legs])
         self.velocity_limit = np.array([leg.velocity_limit for leg in legs])
@@ -176,24 +184,30 @@ class WholeBody:
         """
         angles = np.asarray(q, dtype=float)
         n = angles.shape[0]
-        pos = np.zeros((n, 4, 3))
-        rot = np.broadcast_to(np.eye(3), (n, 4, 3, 3)).copy()
+        sin, cos = np.sin(angles)[..., None, None], 1.0 - np.cos(angles)[..., None, None]
+        pos = np.zeros((n, 4, 3, 1))
+        rot = np.broadcast_to(np.eye(3), (n, 4, 3, 3))
         positions = np.empty((n, 4, 3, 3))
         rotations = np.empty((n, 4, 3, 3, 3))
         axes = np.empty((n, 4, 3, 3))
         anchors = np.empty((n, 4, 3, 3))
         for k in range(3):
-            pos = pos + np.einsum("nlij,lj->nli", rot, self._body_pos[:, k])
+            pos = pos + rot @ self._body_pos_col[:, k]
             rot = rot @ self._body_rot[:, k]
-            anchor_base = pos + np.einsum("nlij,lj->nli", rot, self._anchor[:, k])
-            axis_base = np.einsum("nlij,lj->nli", rot, self._axis[:, k])
-            turn = _axis_angle_batch(self._axis[None, :, k], angles[:, :, k])
-            pos = anchor_base - np.einsum("nlij,lj->nli", rot @ turn, self._anchor[:, k])
+            anchor_base = pos + rot @ self._anchor_col[:, k]
+            # Rodrigues with the axis' constant [a]× and [a]×²: turn = I + sin·K + (1 − cos)·K².
+            turn = np.eye(3) + sin[:, :, k] * self._k1[:, k] + cos[:, :, k] * self._k2[:, k]
+            turned_anchor = (
+                self._anchor_col[:, k]
+                + sin[:, :, k] * self._k1_anchor[:, k]
+                + cos[:, :, k] * self._k2_anchor[:, k]
+            )
+            axes[:, :, k] = (rot @ self._axis_col[:, k])[..., 0]
+            pos = anchor_base - rot @ turned_anchor
             rot = rot @ turn
-            positions[:, :, k] = pos
+            positions[:, :, k] = pos[..., 0]
             rotations[:, :, k] = rot
-            axes[:, :, k] = axis_base
-            anchors[:, :, k] = anchor_base
+            anchors[:, :, k] = anchor_base[..., 0]
         return positions, rotations, axes, anchors
 
     def foot_positions(self, q: ArrayLike, frames: Frames | None = None) -> NDArray[np.float64]:

@@ -1,0 +1,136 @@
+"""Milliseconds to produce one optimised footstep trajectory on the LittleDog boards.
+
+For each board of ``../shared/terrains/littledog`` a plan crosses it (the
+footstep planner's when ``roughwalk.plan_footsteps`` exists, else a straight
+crawl whose certificates are only heuristic), and every footstep's trajectory
+is generated (Zucker 2011, §5: timing, ZMP preview, splines, CHOMP, restarts,
+checks at the control rate). The time per footstep is what the executor
+waits for, restarts included; the target is ≤ 50 ms, so the next step is
+ready long before the current one ends. The SDF is built once per board and
+not counted. Prints a table and writes ``benchmarks/results/trajectory.json``.
+
+Run: ``python3 benchmarks/bench_trajectory.py [--quick] [--steps N]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import roughwalk as rw
+from roughwalk.cli.common import machine_description, result_envelope, write_json
+from roughwalk.trajectories import FootstepTrajectoryGenerator, straight_crawl_plan
+
+RESULTS = Path(__file__).resolve().parent / "results" / "trajectory.json"
+SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "terrains" / "littledog"
+BOARDS = ("A", "AC", "AD", "AE", "C", "Y")
+TARGET_MS = 50.0
+
+
+def make_plan(robot: rw.Robot, terrain: rw.Terrain, steps: int) -> tuple[Any, str]:
+    """A plan across the board and where it came from."""
+    x0, x1, y0, y1 = terrain.extent
+    planner = getattr(rw, "plan_footsteps", None)
+    if planner is not None:
+        try:
+            start = (x0 + 0.13, 0.5 * (y0 + y1))
+            goal = (x1 - 0.13, 0.5 * (y0 + y1))
+            return planner(robot, terrain, start=start, goal=goal), "footstep planner"
+        except (TypeError, rw.RoughwalkError):
+            pass  # a different signature or no plan: fall back to the crawl
+    plan = straight_crawl_plan(
+        robot, terrain, (x0 + 0.13, 0.5 * (y0 + y1)), steps=steps, stride=0.05
+    )
+    return plan, "straight crawl (heuristic certificates)"
+
+
+def run_board(robot: rw.Robot, name: str, steps: int) -> dict[str, Any]:
+    """Generate every footstep of a plan across board ``name``; per-step times and validity."""
+    terrain = rw.load_terrain(SHARED / f"terrain{name}.mat")
+    began = time.perf_counter()
+    sdf = terrain.sdf(0.005)
+    sdf_s = time.perf_counter() - began
+    gen = FootstepTrajectoryGenerator(robot, terrain, sdf=sdf)
+    plan, source = make_plan(robot, terrain, steps)
+    began = time.perf_counter()
+    prepared = gen.prepare(plan)
+    prepare_ms = (time.perf_counter() - began) * 1000.0
+    ms, valid, iterations, attempts = [], [], [], []
+    for traj in gen.iter_steps(prepared):
+        r = traj.report
+        ms.append(r.optimize_ms)
+        valid.append(r.valid)
+        iterations.append(r.iterations)
+        attempts.append(r.attempts)
+    a = np.array(ms)
+    return {
+        "board": name,
+        "plan": source,
+        "steps": len(ms),
+        "valid_fraction": float(np.mean(valid)),
+        "sdf_build_s": sdf_s,
+        "prepare_ms": prepare_ms,
+        "ms_per_step": a.tolist(),
+        "median_ms": float(np.median(a)),
+        "p90_ms": float(np.percentile(a, 90)),
+        "max_ms": float(a.max()),
+        "within_target": float(np.mean(a <= TARGET_MS)),
+        "mean_iterations": float(np.mean(iterations)),
+        "mean_attempts": float(np.mean(attempts)),
+    }
+
+
+def main() -> int:
+    """Run the benchmark."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--quick", action="store_true", help="two boards, four steps each")
+    parser.add_argument("--steps", type=int, default=12, help="footsteps per board (12)")
+    args = parser.parse_args()
+    if not SHARED.is_dir():
+        print(f"the LittleDog boards are not at {SHARED}")
+        return 1
+    robot = rw.load_robot("littledog")
+    boards = BOARDS[:2] if args.quick else BOARDS
+    steps = 4 if args.quick else args.steps
+    # Warm up imports and caches so the first board's first step is not charged for them.
+    run_board(robot, boards[0], 1)
+    rows = [run_board(robot, b, steps) for b in boards]
+    header = (
+        f"{'board':<6} {'steps':>5} {'valid':>6} {'median ms':>9} {'p90 ms':>7} {'max ms':>7} "
+        f"{'≤50 ms':>6} {'iters':>5} {'tries':>5}  plan"
+    )
+    print(header)
+    print("-" * len(header))
+    for r in rows:
+        print(
+            f"{r['board']:<6} {r['steps']:>5} {r['valid_fraction']:>6.0%} {r['median_ms']:>9.1f} "
+            f"{r['p90_ms']:>7.1f} {r['max_ms']:>7.1f} {r['within_target']:>6.0%} "
+            f"{r['mean_iterations']:>5.1f} {r['mean_attempts']:>5.2f}  {r['plan']}"
+        )
+    every = np.concatenate([r["ms_per_step"] for r in rows])
+    print(
+        f"all    {len(every):>5}        {np.median(every):>9.1f} {np.percentile(every, 90):>7.1f} "
+        f"{every.max():>7.1f} {np.mean(every <= TARGET_MS):>6.0%}   (target ≤ {TARGET_MS:g} ms)"
+    )
+    write_json(
+        RESULTS,
+        result_envelope(
+            "bench_trajectory",
+            robot=robot.name,
+            machine=machine_description(),
+            target_ms=TARGET_MS,
+            boards=rows,
+            median_ms=float(np.median(every)),
+            p90_ms=float(np.percentile(every, 90)),
+        ),
+    )
+    print(f"wrote {RESULTS}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
