@@ -178,16 +178,17 @@ impl DistanceGrid {
     pub fn corners(&self, base: usize) -> [f32; 8] {
         let [_, ny, nz] = self.spec.shape;
         let sx = ny * nz;
-        let v = &self.values;
+        // One bounds check for the whole cell instead of eight.
+        let v = &self.values[base..=base + sx + nz + 1];
         [
-            v[base],
-            v[base + 1],
-            v[base + nz],
-            v[base + nz + 1],
-            v[base + sx],
-            v[base + sx + 1],
-            v[base + sx + nz],
-            v[base + sx + nz + 1],
+            v[0],
+            v[1],
+            v[nz],
+            v[nz + 1],
+            v[sx],
+            v[sx + 1],
+            v[sx + nz],
+            v[sx + nz + 1],
         ]
     }
 
