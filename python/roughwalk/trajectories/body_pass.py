@@ -153,13 +153,17 @@ class BodyPass:
         towards = feet_b - self.hips[None]
         dist = np.linalg.norm(towards, axis=-1, keepdims=True)
         pushed = feet_b + self.config.reach_margin * towards / np.maximum(dist, 1e-9)
-        q, reached = self.wb.inverse_kinematics(pushed)
         error_b = np.zeros_like(pushed)
-        # A reached target has no error; forward kinematics only where one is missed.
-        rows = np.flatnonzero(~reached.all(axis=1))
-        if rows.size:
-            error_b[rows] = pushed[rows] - self.wb.foot_positions(q[rows])
-            error_b[rows] *= ~reached[rows][..., None]
+        # Pushing outward only matters near full stretch: solve only those samples.
+        near = np.flatnonzero(np.any(dist[..., 0] > 0.93 * self.wb.max_reach[None, :], axis=1))
+        if near.size:
+            q, reached = self.wb.inverse_kinematics(pushed[near])
+            # A reached target has no error; forward kinematics only where one is missed.
+            missed = ~reached.all(axis=1)
+            if np.any(missed):
+                rows = near[missed]
+                error_b[rows] = pushed[rows] - self.wb.foot_positions(q[missed])
+                error_b[rows] *= ~reached[missed][..., None]
         return np.einsum("tij,tlj->tli", rot, error_b)
 
     def evaluate(self, xi: NDArray[np.float64]) -> Evaluation:

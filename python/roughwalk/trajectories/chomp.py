@@ -62,6 +62,9 @@ class ChompStatus(enum.Enum):
     """The iteration budget ran out."""
     CONVERGED = "converged"
     """No step (even halved) lowered the objective any more."""
+    FIXED_INFEASIBLE = "fixed_samples_infeasible"
+    """Samples CHOMP may not move (ends, lift-off, touchdown) already break a
+    requirement, so it was not run: the plan's poses are at fault."""
 
 
 @dataclass

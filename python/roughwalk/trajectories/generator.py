@@ -357,11 +357,14 @@ class FootstepTrajectoryGenerator:
         After the shortcut the certificate is always tried. A longer step is
         tried only while the last one collided or broke a velocity limit, and
         made progress on that over the attempt before (clearance up by 0.5 mm
-        or the velocity margin up), so hopeless steps are handed on early.
+        or the velocity margin up), so hopeless steps are handed on early;
+        never when the samples CHOMP cannot move were at fault.
         """
         r = result.report
         if was_shortcut:
             return True
+        if r.chomp_status == ChompStatus.FIXED_INFEASIBLE.value:
+            return False
         if r.collision_free and r.velocity_limits_ok:
             return False
         if previous is None or previous.report.used_shortcut:
@@ -400,8 +403,17 @@ class FootstepTrajectoryGenerator:
                 initial = capsule_clearances(
                     self.wb, self.sdf, state.q, state.body[:, :3], state.rotation
                 )
-                initial_min = float(initial[:, ~self.wb.collision.is_foot].min())
-                outcome = self.optimize(state)
+                body_clear = initial[:, ~self.wb.collision.is_foot]
+                initial_min = float(body_clear.min())
+                fixed = [0, state.lift_off, state.touchdown, state.n_samples - 1]
+                if not (
+                    np.all(state.reached[fixed] | ~state.support[fixed])
+                    and body_clear[fixed].min() >= cfg.validity.min_clearance
+                ):
+                    # No update can move these samples: hand the step on untouched.
+                    outcome = OptimizationOutcome(0, ChompStatus.FIXED_INFEASIBLE)
+                else:
+                    outcome = self.optimize(state)
                 result = resample_footstep(
                     state,
                     self.wb,

@@ -143,6 +143,18 @@ class WholeBody:
         self.lower = np.array([leg.lower for leg in legs])
         self.upper = np.array([leg.upper for leg in legs])
         self.velocity_limit = np.array([leg.velocity_limit for leg in legs])
+        # The farthest each foot gets from its hip anchor, over its joint ranges.
+        grid = np.stack(
+            np.meshgrid(*[np.linspace(0.0, 1.0, 9)] * 3, indexing="ij"), axis=-1
+        ).reshape(-1, 3)
+        lo = np.where(np.isfinite(self.lower), self.lower, -np.pi)
+        hi = np.where(np.isfinite(self.upper), self.upper, np.pi)
+        samples = lo[None] + grid[:, None, :] * (hi - lo)[None]
+        hips = np.asarray(robot.hip_positions)
+        self.max_reach = np.linalg.norm(self.foot_positions(samples) - hips[None], axis=-1).max(
+            axis=0
+        )
+        """(4,) the farthest each foot gets from its hip (HAA anchor) [m]."""
         d = robot.description
         self._link_mass = np.asarray(d.link_mass, dtype=float)
         self._link_com = np.asarray(d.link_com, dtype=float)
