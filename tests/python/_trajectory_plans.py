@@ -49,11 +49,12 @@ def barrier_step_plan(
     return {
         "robot": robot.name,
         "terrain": terrain.spec,
+        # Contact points on the flat ground: the foot centres less the radius.
         "footsteps": [
-            {"leg": name, "x": float(f[0]), "y": float(f[1]), "z": float(f[2])}
+            {"leg": name, "x": float(f[0]), "y": float(f[1]), "z": 0.0}
             for name, f in zip(LEG_NAMES, feet, strict=True)
         ]
-        + [{"leg": leg, "x": float(target[0]), "y": float(target[1]), "z": float(target[2])}],
+        + [{"leg": leg, "x": float(target[0]), "y": float(target[1]), "z": 0.0}],
         "initial_pose": {"base_pos": base.tolist(), "base_quat": rpy_to_quat(rpy).tolist()},
         "certificates": [
             {

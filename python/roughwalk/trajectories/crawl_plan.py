@@ -47,6 +47,9 @@ def straight_crawl_plan(
 ) -> dict[str, Any]:
     """A plan dict (``roughwalk plan``'s JSON fields) for a straight crawl.
 
+    Footsteps are contact points, as the planner writes them; the
+    certificates put the foot-sphere centres on the terrain.
+
     Parameters
     ----------
     robot, terrain:
@@ -97,10 +100,13 @@ def straight_crawl_plan(
         z = float(np.max(terrain.height(xy[None] + ring) + lift))
         return np.array([xy[0], xy[1], z])
 
+    def contact(centre: np.ndarray) -> dict[str, Any]:
+        # The plan format holds contact points: the centre less the radius along the normal.
+        c = centre - foot_r * terrain.normal(centre[None, :2])[0]
+        return {"x": float(c[0]), "y": float(c[1]), "z": float(c[2])}
+
     feet = np.array([on_ground(xy0 + rot @ f) for f in footprint])
-    footsteps = [
-        {"leg": LEG_NAMES[i], "x": feet[i, 0], "y": feet[i, 1], "z": feet[i, 2]} for i in range(4)
-    ]
+    footsteps = [{"leg": LEG_NAMES[i], **contact(feet[i])} for i in range(4)]
     direction = rot @ np.array([1.0, 0.0])
     moved = [False] * 4
     sequence = [legs[k % len(legs)] for k in range(steps)]
@@ -111,9 +117,7 @@ def straight_crawl_plan(
         moved[leg] = True
         feet = feet.copy()
         feet[leg] = on_ground(feet[leg, :2] + scale * stride * direction)
-        footsteps.append(
-            {"leg": LEG_NAMES[leg], "x": feet[leg, 0], "y": feet[leg, 1], "z": feet[leg, 2]}
-        )
+        footsteps.append({"leg": LEG_NAMES[leg], **contact(feet[leg])})
         nxt = sequence[k + 1] if k + 1 < steps else legs[(k + 1) % len(legs)]
         support = [i for i in range(4) if i != nxt]
         fit_base, fit_rpy = nominal_fit(body, feet)
@@ -130,8 +134,6 @@ def straight_crawl_plan(
     return {
         "robot": robot.name,
         "terrain": terrain.spec,
-        "footsteps": [
-            {k: (float(v) if k != "leg" else v) for k, v in f.items()} for f in footsteps
-        ],
+        "footsteps": footsteps,
         "certificates": certificates,
     }

@@ -41,7 +41,11 @@ from roughwalk.trajectories.swing_spline import SwingSpline
 from roughwalk.trajectories.timing import StepTiming, step_timing
 from roughwalk.trajectories.whole_body import WholeBody
 from roughwalk.trajectories.zmp_preview import ZmpPreviewController
-from roughwalk.trajectories.zmp_reference import ZmpReference, shortcut_anchor
+from roughwalk.trajectories.zmp_reference import (
+    ZmpReference,
+    closest_point_in_triangle,
+    shortcut_anchor,
+)
 
 if TYPE_CHECKING:
     from roughwalk.robots.robot import Robot
@@ -120,7 +124,9 @@ class FootstepTrajectoryGenerator:
         """Read a plan (see :func:`~roughwalk.trajectories.step_sequence.plan_fields`)."""
         if isinstance(plan, StepSequence):
             return plan
-        return StepSequence.from_plan(plan, self.wb, self.config.zmp.support_margin)
+        return StepSequence.from_plan(
+            plan, self.wb, self.config.zmp.support_margin, terrain=self.terrain
+        )
 
     def controller(self, com_height: float) -> ZmpPreviewController:
         """The preview controller for a CoM height [m] (cached per millimetre)."""
@@ -264,21 +270,31 @@ class FootstepTrajectoryGenerator:
 
     def _window(
         self,
+        prepared: PreparedPlan,
         k: int,
         start: StartState,
         timing: StepTiming,
         anchor: NDArray[np.float64],
-        anchors: NDArray[np.float64],
-        timings: list[StepTiming],
-        n_steps: int,
     ) -> tuple[NDArray[np.float64], int]:
         """ZMP reference samples over the preview window from step k, and its length N."""
+        n_steps = len(prepared.sequence)
+        anchors = prepared.anchors
         last = min(k + self.config.zmp.preview_steps, n_steps)
-        window = [timing] + timings[k + 1 : last]
+        window = [timing] + prepared.timings[k + 1 : last]
         points = [start.zmp_anchor, anchor, *anchors[k + 2 : last + 1]]
         if last == n_steps:
             points.append(anchors[n_steps + 1])
-        ref = ZmpReference.through_anchors(np.array(points), window, start.time)
+        # Each swing moves the ZMP toward the next anchor, as far as its triangle
+        # allows with the margin the support term asks for.
+        margin = self.config.chomp.zmp_margin
+        steps = prepared.sequence.steps
+        exits = [
+            closest_point_in_triangle(points[j + 2], steps[k + j].support_triangle, margin)
+            if j + 2 < len(points)
+            else points[j + 1]
+            for j in range(len(window))
+        ]
+        ref = ZmpReference.through_anchors(np.array(points), window, start.time, np.array(exits))
         total = sum(t.duration_s for t in window)
         m = int(round(total / self.dt))
         samples = ref.sample(start.time + self.dt * np.arange(m + 1))
@@ -322,9 +338,7 @@ class FootstepTrajectoryGenerator:
         pose = shortcut if use_shortcut and shortcut is not None else step.swing_pose
         timing = prepared.timings[k].scaled(scale).quantized(self.dt)
         anchor = pose.com[:2].copy()
-        reference, horizon = self._window(
-            k, start, timing, anchor, prepared.anchors, prepared.timings, len(prepared.sequence)
-        )
+        reference, horizon = self._window(prepared, k, start, timing, anchor)
         support_z = float(np.mean(step.support_triangle[:, 2]))
         state = build_initial_trajectory(
             self.wb,
@@ -338,7 +352,7 @@ class FootstepTrajectoryGenerator:
             horizon,
             self.config.swing,
             self.terrain,
-            end_pose=step.end_pose if timing.settle_s > 0 else None,
+            end_pose=step.end_pose,
             used_shortcut=use_shortcut and shortcut is not None,
         )
         radius = self.wb.collision.radius[
@@ -430,8 +444,8 @@ class FootstepTrajectoryGenerator:
                 previous = result
             assert result is not None and state is not None
             yield result
-            settled = state.timing.settle_s > 0
-            last_anchor = prepared.anchors[-1] if settled else state.anchor
+            # The next shift starts where this step left the ZMP reference.
+            last_anchor = state.zmp_reference[-1]
             start = StartState(
                 time=float(state.times[-1]),
                 base_pos=state.body[-1, :3].copy(),

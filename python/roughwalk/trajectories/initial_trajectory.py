@@ -162,7 +162,9 @@ def build_initial_trajectory(
     swing_config, terrain:
         For the swing foot's lift-off and drop-off points.
     end_pose:
-        With a settling phase: the pose to settle into.
+        The certificate of the stance the step reaches: the trunk's height and
+        tilt at touchdown (and through the settling phase); None holds the
+        swing pose.
     used_shortcut:
         Recorded in the result.
     """
@@ -173,6 +175,10 @@ def build_initial_trajectory(
     lift_off, touchdown = n_shift, n_shift + n_swing
 
     # Trunk height, orientation and CoM offset: smoothstep between keyframes (§5.2).
+    # The shift brings the trunk to the swing pose; the swing carries it on to
+    # the certificate of the stance it reaches, whose height and tilt let the
+    # foot land (the planner checked that pose, not the swing pose, against
+    # the new foothold).
     rpy_swing = swing_pose.rpy.copy()
     rpy_swing[2] = _unwrap_to(rpy_swing[2], float(start.rpy[2]))
     knots = [t0, times[lift_off], times[touchdown]]
@@ -180,12 +186,15 @@ def build_initial_trajectory(
         np.concatenate([[start.base_pos[2]], start.rpy, start.com_offset]),
         np.concatenate([[swing_pose.base_pos[2]], rpy_swing, swing_pose.com_offset]),
     ]
-    values.append(values[-1])
-    if n_settle and end_pose is not None:
+    if end_pose is not None:
         rpy_end = end_pose.rpy.copy()
         rpy_end[2] = _unwrap_to(rpy_end[2], float(rpy_swing[2]))
-        knots.append(times[-1])
         values.append(np.concatenate([[end_pose.base_pos[2]], rpy_end, end_pose.com_offset]))
+    else:
+        values.append(values[-1])
+    if n_settle:
+        knots.append(times[-1])
+        values.append(values[-1])
     spline = BodySpline(np.array(knots), np.array(values))
     pose, pose_rate, pose_acc = spline.evaluate(times)
     offset = pose[:, 4:7]

@@ -2,10 +2,16 @@
 
 Accepts the footstep planner's :class:`FootstepPlan` or its JSON (``roughwalk
 plan``): ``footsteps`` [{leg, x, y, z}] in execution order starting with the
-four feet of the initial stance, and ``certificates`` [{step, base_pos,
-base_quat, q}], one per footstep after the initial stance: the pose holding
-the stance that step reaches with the CoM inside the support triangle of the
-next step (Zucker 2011, §4.3). Missing pieces are filled as a certificate
+four feet of the initial stance, each the foot's contact point on the
+terrain; ``certificates`` [{step, base_pos, base_quat, q}], one per footstep
+after the initial stance: the pose holding the stance that step reaches with
+the CoM inside the support triangle of the next step (Zucker 2011, §4.3);
+and optionally ``initial_pose``, the initial stance's certificate.
+
+Trajectories need foot-sphere centres: a contact point plus the foot radius
+along the terrain's normal, or, where a certificate places that foot within
+a centimetre of it, exactly where the certificate's joint angles put it (the
+centre the planner checked). Missing pieces are filled as a certificate
 search would start them (:func:`pose_over_support`): the initial pose, the
 pose for the first step, certificates of a bare footstep list.
 """
@@ -16,7 +22,7 @@ import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,7 +36,11 @@ from roughwalk.trajectories.body_keyframes import (
     pose_over_support,
     rpy_of,
 )
+from roughwalk.trajectories.euler import rpy_to_matrix
 from roughwalk.trajectories.whole_body import WholeBody
+
+if TYPE_CHECKING:
+    from roughwalk.terrain.terrain import Terrain
 
 __all__ = ["StepSpec", "StepSequence", "plan_fields"]
 
@@ -116,6 +126,49 @@ def plan_fields(plan: Any) -> dict[str, Any]:
     }
 
 
+def contacts_at(leg: int, contact: NDArray[np.float64]) -> NDArray[np.float64]:
+    """A (4, 3) array with ``contact`` in row ``leg`` (the others unused)."""
+    out = np.zeros((4, 3))
+    out[leg] = contact
+    return out
+
+
+def _foot_centres(
+    wb: WholeBody,
+    terrain: Terrain | None,
+    contacts: NDArray[np.float64],
+    legs: Any,
+    certificate: Any,
+) -> NDArray[np.float64]:
+    """Foot-sphere centres (4, 3) [m] of the ``legs`` rows of ``contacts`` (others copied).
+
+    Contact plus radius along the normal; or the certificate's own foot
+    centre where its joint angles put the foot within 1 cm of that.
+    """
+    out = np.array(contacts, dtype=float)
+    legs = list(legs)
+    xy = out[legs, :2]
+    normals = (
+        terrain.normal(xy) if terrain is not None else np.tile([0.0, 0.0, 1.0], (len(legs), 1))
+    )
+    radius = np.array([wb.robot.leg_descriptions[i].foot_radius for i in legs])
+    out[legs] = out[legs] + radius[:, None] * normals
+    q = None if certificate is None else _get(certificate, "q")
+    if q is not None:
+        try:
+            q12 = np.asarray(q, dtype=float)
+            pos, rpy = _pose(certificate, "certificate")
+        except PlanningError:
+            return out
+        if q12.shape == (12,) and np.all(np.isfinite(q12)):
+            rot = rpy_to_matrix(rpy)
+            feet = pos + wb.foot_positions(wb.robot.to_canonical(q12).reshape(1, 4, 3))[0] @ rot.T
+            for i in legs:
+                if np.linalg.norm(feet[i] - out[i]) < 0.01:
+                    out[i] = feet[i]
+    return out
+
+
 def _leg_index(value: Any, where: str) -> int:
     if isinstance(value, str) and value.upper() in LEG_NAMES:
         return LEG_NAMES.index(value.upper())
@@ -179,11 +232,19 @@ class StepSequence:
         return len(self.steps)
 
     @classmethod
-    def from_plan(cls, plan: Any, wb: WholeBody, support_margin: float = 0.015) -> StepSequence:
+    def from_plan(
+        cls,
+        plan: Any,
+        wb: WholeBody,
+        support_margin: float = 0.015,
+        terrain: Terrain | None = None,
+    ) -> StepSequence:
         """Read ``plan`` (see :func:`plan_fields`) for the robot of ``wb``.
 
         ``support_margin`` [m] is the CoM margin of the keyframes made here
-        (the initial stance's swing pose and missing certificates).
+        (the initial stance's swing pose and missing certificates);
+        ``terrain`` gives the normals that turn contact points into foot
+        centres (vertical without it).
         """
         fields = plan_fields(plan)
         entries = fields["footsteps"]
@@ -192,14 +253,14 @@ class StepSequence:
                 f"a footstep plan needs the 4 feet of its initial stance and at least one step; "
                 f"got {len(entries)} footsteps"
             )
-        stance = np.full((4, 3), np.nan)
+        contacts = np.full((4, 3), np.nan)
         for i, entry in enumerate(entries[:4]):
             leg, pos = _footstep(entry, f"footsteps[{i}]")
-            if np.all(np.isfinite(stance[leg])):
+            if np.all(np.isfinite(contacts[leg])):
                 raise PlanningError(
                     f"footsteps[{i}]: leg {LEG_NAMES[leg]} appears twice in the initial stance"
                 )
-            stance[leg] = pos
+            contacts[leg] = pos
         moves = [_footstep(e, f"footsteps[{i}]") for i, e in enumerate(entries[4:], start=4)]
         certs = fields["certificates"]
         if certs and len(certs) != len(moves):
@@ -211,12 +272,22 @@ class StepSequence:
             certs = sorted(certs, key=lambda c: int(_get(c, "step")))
 
         init = fields["initial_pose"]
+        stance = _foot_centres(wb, terrain, contacts, range(4), init)
         if init is not None:
             pos, rpy = _pose(init, "initial_pose")
             initial = keyframe_at(wb, stance, pos, rpy)
         else:
             base, rpy = nominal_fit(wb, stance)
             initial = keyframe_at(wb, stance, base, rpy)
+        moves = [
+            (
+                leg,
+                _foot_centres(wb, terrain, contacts_at(leg, c), [leg], certs[k] if certs else None)[
+                    leg
+                ],
+            )
+            for k, (leg, c) in enumerate(moves)
+        ]
 
         steps: list[StepSpec] = []
         before = stance

@@ -7,7 +7,10 @@ The linear spline path is transformed into a time-referenced trajectory by
 considering the estimated duration for each footstep." Here the anchor of a
 step is the certificate's centre of mass (what the certificate guarantees to
 lie in the support triangle): during the step's shift phase the ZMP moves in
-a straight line from the previous anchor to it, during the swing it holds.
+a straight line from the previous anchor to it; during the swing it moves
+on, inside the swing's support triangle, to the point of that triangle
+nearest the next anchor (:func:`closest_point_in_triangle`), so that the
+trunk comes within reach of the next certificate by touchdown.
 
 Footnote 2: "to achieve faster walking speeds and minimize the displacement
 of the trunk, we also test a 'shortcut' ZMP position that reduces the overall
@@ -26,7 +29,13 @@ from numpy.typing import ArrayLike, NDArray
 from roughwalk.errors import InvalidArgumentError
 from roughwalk.trajectories.timing import StepTiming
 
-__all__ = ["ZmpReference", "shortcut_anchor", "shrink_triangle", "inside_triangle"]
+__all__ = [
+    "ZmpReference",
+    "shortcut_anchor",
+    "shrink_triangle",
+    "inside_triangle",
+    "closest_point_in_triangle",
+]
 
 
 class ZmpReference:
@@ -46,16 +55,21 @@ class ZmpReference:
 
     @classmethod
     def through_anchors(
-        cls, anchors: ArrayLike, timings: Sequence[StepTiming], start_time: float = 0.0
+        cls,
+        anchors: ArrayLike,
+        timings: Sequence[StepTiming],
+        start_time: float = 0.0,
+        exits: ArrayLike | None = None,
     ) -> ZmpReference:
         """The reference of consecutive footsteps.
 
         ``anchors`` (S + 1, 2) [m]: the ZMP at rest before the first step,
         then one per step (inside that step's support triangle); with a
         settling phase on the last step, one more: where the ZMP comes to rest.
-        Step k shifts from anchor k − 1 to anchor k, then holds it through
-        its swing; a settling phase moves to the final anchor in its first
-        half and holds it.
+        Step k shifts from anchor k − 1 to anchor k, then moves through its
+        swing to ``exits[k]`` (S, 2) (default: holds anchor k); the next
+        shift starts from there. A settling phase moves to the final anchor in
+        its first half and holds it.
         """
         a = np.asarray(anchors, dtype=float)
         settle = any(t.settle_s > 0 for t in timings)
@@ -64,6 +78,11 @@ class ZmpReference:
             raise InvalidArgumentError(
                 f"{len(timings)} steps{' with settling' if settle else ''} need "
                 f"{expected} ZMP anchors (2-D), got shape {a.shape}"
+            )
+        out = a[1 : len(timings) + 1] if exits is None else np.asarray(exits, dtype=float)
+        if out.shape != (len(timings), 2):
+            raise InvalidArgumentError(
+                f"exits must have shape ({len(timings)}, 2), one per step; got {out.shape}"
             )
         times = [start_time]
         points = [a[0]]
@@ -74,7 +93,7 @@ class ZmpReference:
             points.append(a[k])
             t += timing.swing_s
             times.append(t)
-            points.append(a[k])
+            points.append(out[k - 1])
             if timing.settle_s > 0:
                 times.append(t + timing.settle_s / 2)
                 points.append(a[k + 1])
@@ -133,6 +152,26 @@ def inside_triangle(
         signs.append((b[0] - a[0]) * (p[:, 1] - a[1]) - (b[1] - a[1]) * (p[:, 0] - a[0]))
     s = np.stack(signs, axis=1)
     return np.all(s >= -tol, axis=1) | np.all(s <= tol, axis=1)
+
+
+def closest_point_in_triangle(
+    point: ArrayLike, triangle: ArrayLike, margin: float
+) -> NDArray[np.float64]:
+    """The point (2,) of ``triangle`` shrunk by ``margin`` [m] nearest to ``point`` (2,) [m]."""
+    p = np.asarray(point, dtype=float)[:2]
+    inner = shrink_triangle(triangle, margin)
+    if inside_triangle(p[None], inner)[0]:
+        return p.copy()
+    best, best_d = inner[0], np.inf
+    for i in range(3):
+        a, b = inner[i], inner[(i + 1) % 3]
+        ab = b - a
+        t = float(np.clip((p - a) @ ab / max(float(ab @ ab), 1e-24), 0.0, 1.0))
+        c = a + t * ab
+        d = float(np.linalg.norm(p - c))
+        if d < best_d:
+            best, best_d = c, d
+    return np.asarray(best, dtype=float)
 
 
 def shortcut_anchor(
