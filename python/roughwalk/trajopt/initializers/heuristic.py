@@ -1,10 +1,14 @@
 """TOWR's heuristic initial guess (Melon 2020, §IV): a straight base, even footholds and timing.
 
-The base moves on the straight line from start to goal at constant speed;
-each stance foothold is the nominal stance under the base at the middle of
-that stance phase (the last one under the goal pose), on the terrain; the
-phase durations are the gait's; the forces share the weight among the feet
-in stance.
+The base moves on the straight line from start to goal at constant speed
+while the feet step (it rests during the stand phases at both ends); each
+foot's footholds are evenly spaced from its start foothold to its nominal
+foothold at the goal, on the terrain, moved along the path off steep ground
+and step edges when one falls there (our addition: on a step's smoothed edge
+the friction pyramid lies on its side), and the base pitches and rolls with
+the ground under its nominal feet;
+the phase durations are the gait's; the forces share the weight among the
+feet in stance.
 """
 
 from __future__ import annotations
@@ -20,10 +24,10 @@ from roughwalk.trajopt.initializers.guess import (
     finite_difference,
     forces_guess,
     node_times,
+    off_edges,
     straight_base,
 )
 from roughwalk.trajopt.task import ResolvedTask, nominal_feet
-from roughwalk.trajopt.variables import euler_to_rotation
 
 __all__ = ["HeuristicInitializer", "base_guess"]
 
@@ -59,25 +63,24 @@ class HeuristicInitializer:
         """The initial variable vector for ``task``."""
         parts = base_guess(nlp, task)
         durations = [np.asarray(d.nominal) for d in nlp.durations]
+        direction = task.goal_xy - task.base_position[:2]
+        if np.linalg.norm(direction) < 1e-6:
+            direction = np.array([np.cos(task.base_euler[2]), np.sin(task.base_euler[2])])
+        gx, gy = (float(v) for v in task.goal_xy)
+        goal_feet, _ = nominal_feet(nlp.body, nlp.terrain, gx, gy, float(task.goal_euler[2]))
         for foot in range(nlp.n_feet):
-            bounds = np.concatenate([[0.0], np.cumsum(durations[foot])])
+            # Evenly spaced footholds from the start foothold to the goal's (Melon 2020, §IV).
+            stances = nlp.stance_phases(foot)
+            start, goal = task.feet[foot], goal_feet[foot]
             footholds: dict[int, NDArray[np.float64]] = {}
-            last = len(durations[foot]) - 1
-            for phase in nlp.stance_phases(foot):
+            for j, phase in enumerate(stances):
                 if nlp.fixed_foothold(foot, phase):
-                    footholds[phase] = task.feet[foot]
-                    continue
-                if phase == last:
-                    gx, gy = (float(v) for v in task.goal_xy)
-                    feet, _ = nominal_feet(nlp.body, nlp.terrain, gx, gy, float(task.goal_euler[2]))
-                    footholds[phase] = feet[foot]
-                    continue
-                t_mid = 0.5 * (bounds[phase] + bounds[phase + 1])
-                base, euler = straight_base(nlp, task, np.array([t_mid]))
-                rot = euler_to_rotation(euler[0])
-                p = base[0] + rot @ nlp.body.stance[foot]
-                p[2] = float(nlp.terrain.height(p[None, :2])[0])
-                footholds[phase] = p
+                    footholds[phase] = start
+                elif j == len(stances) - 1:
+                    footholds[phase] = goal
+                else:
+                    p = start + (goal - start) * j / max(len(stances) - 1, 1)
+                    footholds[phase] = off_edges(nlp, p, direction)
             parts[nlp.feet[foot].name] = feet_guess(nlp, task, foot, durations[foot], footholds)
             parts[nlp.forces[foot].name] = forces_guess(nlp, foot, durations[foot], durations)
             parts[nlp.durations[foot].name] = nlp.durations[foot].pack(durations[foot])
