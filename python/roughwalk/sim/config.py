@@ -1,0 +1,340 @@
+"""Settings of the simulated runs (Zucker 2011, §6), with units and what each trades off.
+
+Override any field by dotted key: ``roughwalk.run(..., **{"reflex.body_position_m":
+0.05})`` or ``roughwalk run --set reflex.body_position_m=0.05``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from roughwalk.errors import ConfigError
+
+__all__ = [
+    "SimConfig",
+    "WorldConfig",
+    "ContactConfig",
+    "ControllerConfig",
+    "IntegratorConfig",
+    "ReflexConfig",
+    "OutcomeConfig",
+    "ExecutorConfig",
+]
+
+
+def _positive(obj: object, names: tuple[str, ...], prefix: str) -> None:
+    for name in names:
+        v = getattr(obj, name)
+        if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
+            raise ConfigError(f"{prefix}.{name} must be a positive number, got {v!r}")
+
+
+def _nonnegative(obj: object, names: tuple[str, ...], prefix: str) -> None:
+    for name in names:
+        v = getattr(obj, name)
+        if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
+            raise ConfigError(f"{prefix}.{name} must be a number ≥ 0, got {v!r}")
+
+
+@dataclass(frozen=True)
+class ContactConfig:
+    """Foot–terrain contact of a small robot with rubber feet.
+
+    Attributes
+    ----------
+    friction:
+        Sliding friction coefficient μ. Rubber on wood, rock or plastic boards
+        is about 0.8–1.0; lower values make the feet slip on slopes.
+    torsional_friction, rolling_friction:
+        MuJoCo's torsional [m] and rolling [m] friction; used only with
+        ``condim`` 4 or 6.
+    condim:
+        Contact dimensionality: 3 (normal + tangential friction) suits a
+        point-like spherical foot; 4 adds torsion, 6 rolling.
+    timeconst:
+        Contact stiffness as MuJoCo's ``solref`` time constant [s]: how fast a
+        penetration is pushed out. Must be at least twice the physics step;
+        smaller is stiffer (a hard board under a rubber sole sinks ~1 mm).
+    dampratio:
+        Contact damping ratio (``solref``'s second value); 1 is critical.
+    solimp:
+        MuJoCo's ``solimp`` (d0, d_width, width [m], midpoint, power): the
+        impedance rising from d0 to d_width over ``width`` of penetration.
+    """
+
+    friction: float = 1.0
+    torsional_friction: float = 0.005
+    rolling_friction: float = 0.0001
+    condim: int = 3
+    timeconst: float = 0.005
+    dampratio: float = 1.0
+    solimp: tuple[float, ...] = (0.9, 0.95, 0.001, 0.5, 2.0)
+
+    def __post_init__(self) -> None:
+        _positive(self, ("timeconst", "dampratio"), "world.contact")
+        _nonnegative(self, ("friction", "torsional_friction", "rolling_friction"), "world.contact")
+        if self.condim not in (1, 3, 4, 6):
+            raise ConfigError(f"world.contact.condim must be 1, 3, 4 or 6, got {self.condim}")
+        if len(self.solimp) != 5:
+            raise ConfigError(f"world.contact.solimp needs 5 numbers, got {self.solimp}")
+
+
+@dataclass(frozen=True)
+class WorldConfig:
+    """The MuJoCo model and its clocks.
+
+    Attributes
+    ----------
+    physics_hz:
+        Physics rate [Hz]; must be an integer multiple of ``control_hz``.
+        2 kHz keeps the 10 mm feet and the 10⁻⁵ kg·m² links of LittleDog
+        stable with stiff contacts; higher costs time linearly.
+    control_hz:
+        Controller rate [Hz]: the executor reads the state and sets the
+        servo targets this often (LittleDog's onboard loop ran at 500 Hz).
+    hfield_base:
+        Thickness [m] of the solid slab MuJoCo puts under the height field.
+    contact:
+        Foot–terrain contact (:class:`ContactConfig`).
+    integrator:
+        MuJoCo integrator: "implicitfast" (stable with the servos' damping)
+        or "euler", "rk4", "implicit".
+    """
+
+    physics_hz: float = 2000.0
+    control_hz: float = 500.0
+    hfield_base: float = 0.05
+    contact: ContactConfig = field(default_factory=ContactConfig)
+    integrator: str = "implicitfast"
+
+    def __post_init__(self) -> None:
+        _positive(self, ("physics_hz", "control_hz", "hfield_base"), "world")
+        ratio = self.physics_hz / self.control_hz
+        if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
+            raise ConfigError(
+                f"world.physics_hz ({self.physics_hz}) must be an integer multiple of "
+                f"world.control_hz ({self.control_hz})"
+            )
+        if self.integrator not in ("euler", "rk4", "implicit", "implicitfast"):
+            raise ConfigError(
+                f"world.integrator must be euler, rk4, implicit or implicitfast, "
+                f"got {self.integrator!r}"
+            )
+        if 2.0 / self.physics_hz > self.contact.timeconst:
+            raise ConfigError(
+                f"world.contact.timeconst ({self.contact.timeconst} s) must be at least two "
+                f"physics steps ({2.0 / self.physics_hz} s)"
+            )
+
+    @property
+    def substeps(self) -> int:
+        """Physics steps per control tick."""
+        return int(round(self.physics_hz / self.control_hz))
+
+
+@dataclass(frozen=True)
+class ControllerConfig:
+    """Joint-level control (Zucker 2011, §6: PD servos, force control to soften impacts).
+
+    Attributes
+    ----------
+    gravity_compensation:
+        Add the torques that hold the planned ground forces and the legs'
+        own weight as a feed-forward (shifted into the position servos'
+        targets). Without it every joint sags by τ/kp.
+    velocity_feedforward:
+        Track the planned joint velocities (the servo damps relative to them)
+        instead of damping towards rest.
+    touchdown_stiffness:
+        Servo stiffness scale (0–1] of a swing leg near and just after
+        touchdown, and of any leg whose measured force jumps above plan.
+        Softer absorbs the impact; too soft lets the leg fold.
+    touchdown_window_s:
+        How long before the planned touchdown the leg softens [s].
+    recover_s:
+        Time [s] over which a softened leg returns to full stiffness once it
+        bears weight.
+    impact_force_n:
+        A swing foot touching the terrain with more than this force [N]
+        counts as an early touchdown and softens its leg.
+    """
+
+    gravity_compensation: bool = True
+    velocity_feedforward: bool = True
+    touchdown_stiffness: float = 0.4
+    touchdown_window_s: float = 0.06
+    recover_s: float = 0.08
+    impact_force_n: float = 2.0
+
+    def __post_init__(self) -> None:
+        if not (0 < self.touchdown_stiffness <= 1):
+            raise ConfigError(
+                f"controller.touchdown_stiffness must be in (0, 1], got {self.touchdown_stiffness}"
+            )
+        _nonnegative(self, ("touchdown_window_s", "recover_s", "impact_force_n"), "controller")
+
+
+@dataclass(frozen=True)
+class IntegratorConfig:
+    """The per-leg integrator of Zucker 2011, §6: Δ ← Δ + γ(f_B − f̄_B), q ← IK_B(f_B + Δ).
+
+    Attributes
+    ----------
+    enabled:
+        Run the integrators at all.
+    gain:
+        γ per control tick (dimensionless). The body error closes with a
+        time constant of about 1/(γ·control_hz): 0.004 at 500 Hz is ~0.5 s,
+        "slow-moving" as the paper says; larger corrects faster but fights
+        the planned motion and can oscillate.
+    max_offset_m:
+        Largest |Δ| per leg [m]; the integrator cannot correct more.
+    flight_decay_s:
+        Time constant [s] with which Δ decays to zero while the foot is in
+        flight, so the foot lands where planned.
+    """
+
+    enabled: bool = True
+    gain: float = 0.004
+    max_offset_m: float = 0.03
+    flight_decay_s: float = 0.05
+
+    def __post_init__(self) -> None:
+        _nonnegative(self, ("gain",), "integrator")
+        _positive(self, ("max_offset_m", "flight_decay_s"), "integrator")
+
+
+@dataclass(frozen=True)
+class ReflexConfig:
+    """Errors that trigger the reflex, and what it does (Zucker 2011, §6 and §4.5).
+
+    Attributes
+    ----------
+    enabled:
+        Watch for execution errors at all (off: the robot walks on blindly).
+    body_position_m:
+        Trunk position error [m] beyond which the reflex fires.
+    body_orientation_rad:
+        Trunk orientation error [rad] (angle of R̄Rᵀ) beyond which it fires.
+    foot_position_m:
+        A supporting foot this far [m] from where it should be (a slip).
+    foot_force_n:
+        While three feet support the robot, one planned to bear at least this
+        much [N] that measures less than ``foot_force_fraction`` of its plan
+        has lost its footing (with four down the load sharing is statically
+        indeterminate, so an unloaded foot is no error).
+    foot_force_fraction:
+        See ``foot_force_n``.
+    persist_s:
+        An error must last this long [s] to count, so impact transients do not.
+    settle_s:
+        After all four feet are down, hold still this long [s] before re-planning.
+    lower_s:
+        Time [s] to put all four feet down and centre the trunk over them.
+    replan_budget_s:
+        Time the anytime planner gets to re-plan [s] (the paper's target: walk
+        again within 2 s).
+    max_reflexes:
+        Give up (a failed run) after this many reflexes.
+    """
+
+    enabled: bool = True
+    body_position_m: float = 0.04
+    body_orientation_rad: float = 0.25
+    foot_position_m: float = 0.035
+    foot_force_n: float = 2.0
+    foot_force_fraction: float = 0.05
+    persist_s: float = 0.03
+    settle_s: float = 0.3
+    lower_s: float = 0.5
+    replan_budget_s: float = 2.0
+    max_reflexes: int = 6
+
+    def __post_init__(self) -> None:
+        _positive(
+            self,
+            (
+                "body_position_m",
+                "body_orientation_rad",
+                "foot_position_m",
+                "foot_force_n",
+                "lower_s",
+                "replan_budget_s",
+            ),
+            "reflex",
+        )
+        _nonnegative(self, ("foot_force_fraction", "persist_s", "settle_s"), "reflex")
+        if not (isinstance(self.max_reflexes, int) and self.max_reflexes >= 0):
+            raise ConfigError(
+                f"reflex.max_reflexes must be an integer ≥ 0, got {self.max_reflexes}"
+            )
+
+
+@dataclass(frozen=True)
+class OutcomeConfig:
+    """What counts as success and as a fall.
+
+    Attributes
+    ----------
+    goal_radius_m:
+        The run succeeds when the feet's centroid comes within this distance
+        [m] (in x–y) of the goal.
+    max_roll_rad, max_pitch_rad:
+        Trunk roll and pitch beyond these [rad] count as a fall.
+    slip_m:
+        A supporting foot sliding this far [m] from where it touched down
+        counts as one foot slip.
+    time_limit_s:
+        Simulated time [s] after which an unfinished run fails.
+    """
+
+    goal_radius_m: float = 0.06
+    max_roll_rad: float = 0.6
+    max_pitch_rad: float = 0.6
+    slip_m: float = 0.01
+    time_limit_s: float = 120.0
+
+    def __post_init__(self) -> None:
+        _positive(
+            self,
+            ("goal_radius_m", "max_roll_rad", "max_pitch_rad", "slip_m", "time_limit_s"),
+            "outcome",
+        )
+
+
+@dataclass(frozen=True)
+class ExecutorConfig:
+    """The execution pipeline (Zucker 2011, §6).
+
+    Attributes
+    ----------
+    compute_time_scale:
+        Simulated seconds charged per wall-clock second of on-line planning
+        and trajectory optimisation. 1 is real time on this machine (the
+        paper's setting: optimisation runs in parallel with execution and a
+        late step makes the robot wait); 0 pretends computing is free
+        (reproducible runs, independent of the machine's load).
+    initial_plan_s:
+        Planning time [s] before the clock starts (the trials allowed 90 s;
+        the anytime planner improves its plan until then).
+    """
+
+    compute_time_scale: float = 1.0
+    initial_plan_s: float = 10.0
+
+    def __post_init__(self) -> None:
+        _nonnegative(self, ("compute_time_scale",), "executor")
+        _positive(self, ("initial_plan_s",), "executor")
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """Everything a simulated run takes; see each part's documentation."""
+
+    world: WorldConfig = field(default_factory=WorldConfig)
+    controller: ControllerConfig = field(default_factory=ControllerConfig)
+    integrator: IntegratorConfig = field(default_factory=IntegratorConfig)
+    reflex: ReflexConfig = field(default_factory=ReflexConfig)
+    outcome: OutcomeConfig = field(default_factory=OutcomeConfig)
+    executor: ExecutorConfig = field(default_factory=ExecutorConfig)

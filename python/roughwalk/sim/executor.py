@@ -1,0 +1,445 @@
+"""The :class:`Executor`: plan, optimise and walk, with reflexes and re-planning (Zucker 2011, §6).
+
+The pipeline, in simulated time:
+
+* the initial plan and the first footstep's trajectory are made before the
+  clock starts (the trials allowed planning time before a run);
+* "after the first footstep, trajectory optimization occurs in parallel with
+  execution. As the current step is being executed, the next step gets
+  optimized and appended to the FIFO buffer": when footstep k starts
+  playing, footstep k+1 is generated and its measured wall time w (times
+  :attr:`ExecutorConfig.compute_time_scale`) is charged from that instant;
+  if w is longer than footstep k, the robot holds the end of k and waits, and
+  the wait counts;
+* every control tick the leg integrators correct the trunk, the joint
+  controller turns the commanded angles into servo commands, and the reflex
+  monitor compares the measured state with the plan;
+* a reflex clears the buffer, puts all four feet down and settles
+  (:func:`~roughwalk.sim.recovery.recovery_segment`), then re-plans from the
+  feet where they stand with the anytime planner's budget (2 s); the robot
+  stands still for the planning's wall time and then walks on.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from roughwalk.errors import PlanningError
+from roughwalk.robots.canonical_frame import LEG_NAMES
+from roughwalk.sim.config import SimConfig
+from roughwalk.sim.footstep_source import FootstepSource, PlanAttempt, PlanStart
+from roughwalk.sim.joint_controller import JointController
+from roughwalk.sim.leg_integrator import LegIntegrator
+from roughwalk.sim.outcome import Outcome, OutcomeMonitor
+from roughwalk.sim.recovery import blend_segment, hold_segment, recovery_segment
+from roughwalk.sim.reflexes import ReflexMonitor
+from roughwalk.sim.run_log import RunLog
+from roughwalk.sim.runner import Runner
+from roughwalk.sim.trajectory_buffer import DesiredState, Segment, TrajectoryBuffer
+from roughwalk.sim.world import World
+from roughwalk.trajectories.generator import FootstepTrajectoryGenerator, PreparedPlan
+
+if TYPE_CHECKING:
+    from roughwalk.robots.robot import Robot
+    from roughwalk.sim.disturbances import Disturbance
+    from roughwalk.sim.measured_state import MeasuredState
+    from roughwalk.terrain.terrain import Terrain
+    from roughwalk.trajectories.config import TrajectoryConfig
+    from roughwalk.trajectories.footstep_trajectory import FootstepTrajectory
+
+__all__ = ["Executor", "ProgressCallback"]
+
+ProgressCallback = Callable[[float, float, str], None]
+"""Called every simulated tenth of a second with (sim time [s], progress 0–1, mode)."""
+
+_SETTLE_BEFORE_S = 0.3
+
+
+class _Plan:
+    """One plan being executed: its steps' legs and the trajectory iterator."""
+
+    def __init__(self, attempt: PlanAttempt, prepared: PreparedPlan, steps: Iterator[Any]) -> None:
+        self.attempt = attempt
+        self.prepared = prepared
+        self.steps = steps
+        self.legs = [s.leg for s in prepared.sequence.steps]
+        self.exhausted = False
+
+
+class Executor:
+    """Walks a robot to a goal in a MuJoCo world.
+
+    Parameters
+    ----------
+    robot, terrain:
+        The robot and the true terrain (what the physics uses).
+    source:
+        Where plans come from (:mod:`roughwalk.sim.footstep_source`).
+    config:
+        Simulation settings (:class:`SimConfig`).
+    planner_terrain:
+        The terrain the planner and the trajectory optimiser see (default
+        ``terrain``; a map-error disturbance makes it differ).
+    trajectory_config:
+        Settings of trajectory generation.
+    disturbances:
+        Pushes, friction drops (:mod:`roughwalk.sim.disturbances`).
+    progress:
+        A :data:`ProgressCallback`.
+    sdf:
+        A prebuilt signed distance field of ``planner_terrain``.
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        terrain: Terrain,
+        source: FootstepSource,
+        *,
+        config: SimConfig | None = None,
+        planner_terrain: Terrain | None = None,
+        trajectory_config: TrajectoryConfig | None = None,
+        disturbances: Sequence[Disturbance] = (),
+        progress: ProgressCallback | None = None,
+        sdf: Any = None,
+    ) -> None:
+        self.robot = robot
+        self.terrain = terrain
+        self.source = source
+        self.config = config if config is not None else SimConfig()
+        self.planner_terrain = planner_terrain if planner_terrain is not None else terrain
+        self.world = World(robot, terrain, self.config.world)
+        self.runner = Runner(self.world)
+        self.controller = JointController(self.world, self.config.controller)
+        self.integrator = LegIntegrator(robot, self.config.integrator, self.world.control_dt)
+        self.reflexes = ReflexMonitor(self.config.reflex)
+        self.generator = FootstepTrajectoryGenerator(
+            robot, self.planner_terrain, sdf=sdf, config=trajectory_config
+        )
+        self.buffer = TrajectoryBuffer()
+        self.disturbances = list(disturbances)
+        self.progress = progress
+        self.plans: list[Any] = []
+        self.log = RunLog()
+        self._plan: _Plan | None = None
+        self._step_index = 0
+
+    # ---- planning -------------------------------------------------------------------
+
+    def _make_plan(
+        self, start: PlanStart, goal: np.ndarray, budget: float
+    ) -> tuple[_Plan | None, PlanAttempt, float]:
+        """Plan and make the first footstep's trajectory: (plan, attempt, wall time [s])."""
+        began = time.perf_counter()
+        attempt = self.source.plan(start, goal, budget)
+        if not attempt.ok:
+            return None, attempt, time.perf_counter() - began
+        try:
+            prepared = self.generator.prepare(attempt.plan)
+        except PlanningError as e:
+            failed = PlanAttempt(
+                None, "INVALID", f"the plan cannot be executed: {e}", attempt.wall_s
+            )
+            return None, failed, time.perf_counter() - began
+        self.plans.append(attempt.plan)
+        plan = _Plan(attempt, prepared, self.generator.iter_steps(prepared))
+        return plan, attempt, time.perf_counter() - began
+
+    def _next_step(self, plan: _Plan) -> tuple[FootstepTrajectory | None, float]:
+        """Generate the plan's next footstep; returns it (None at the end) and the wall time [s]."""
+        began = time.perf_counter()
+        try:
+            traj = next(plan.steps)
+        except StopIteration:
+            plan.exhausted = True
+            return None, time.perf_counter() - began
+        return traj, time.perf_counter() - began
+
+    def _charge(self, wall_s: float) -> float:
+        return wall_s * self.config.executor.compute_time_scale
+
+    # ---- the run --------------------------------------------------------------------
+
+    def run(self, start: tuple[float, float, float], goal: Sequence[float]) -> Outcome:
+        """Walk from the trunk pose ``start`` (x [m], y [m], yaw [rad]) to ``goal`` (x, y) [m]."""
+        cfg = self.config
+        goal_xy = np.asarray(goal, dtype=float)[:2]
+        log = self.log
+        log.meta.update(
+            robot=self.robot.name,
+            terrain=self.terrain.spec,
+            planner_terrain=self.planner_terrain.spec,
+            start=list(start),
+            goal=goal_xy.tolist(),
+            physics_hz=cfg.world.physics_hz,
+            control_hz=cfg.world.control_hz,
+            joint_names=list(self.robot.joint_names),
+            nq=int(self.world.model.nq),
+            source=self.source.name,
+            disturbances=[d.describe() for d in self.disturbances],
+        )
+        plan, attempt, wall = self._make_plan(
+            PlanStart(pose=(float(start[0]), float(start[1]), float(start[2]))),
+            goal_xy,
+            cfg.executor.initial_plan_s,
+        )
+        log.event(0.0, "plan", status=attempt.status, wall_s=wall, source=self.source.name)
+        first = self._next_step(plan)[0] if plan is not None else None
+        if plan is None or first is None:
+            reason = attempt.reason if plan is None else "the plan has no footsteps"
+            centroid = self._stance_centroid(start)
+            monitor = OutcomeMonitor(goal_xy, centroid, cfg.outcome)
+            return monitor.finish(0.0, failure=f"no plan: {reason}")
+        self._plan = plan
+        segment = Segment.from_footstep(first)
+        measured = self.runner.reset(segment.q[0], segment.base_pos[0], segment.base_quat[0])
+        monitor = OutcomeMonitor(goal_xy, measured.feet_centroid, cfg.outcome)
+        # The robot settles on its feet before the clock starts.
+        self.buffer.append(hold_segment(segment.sample(0.0), _SETTLE_BEFORE_S, 0.0, kind="hold"))
+        self.buffer.append(segment.with_ready_at(0.0))
+        return self._loop(measured, monitor, goal_xy)
+
+    def _stance_centroid(self, start: Sequence[float]) -> np.ndarray:
+        return np.asarray(start, dtype=float)[:2]
+
+    def _loop(self, measured: MeasuredState, monitor: OutcomeMonitor, goal: np.ndarray) -> Outcome:
+        cfg = self.config
+        dt = self.world.control_dt
+        log = self.log
+        reflexes = replans = steps_done = 0
+        wait_s = replan_s = 0.0
+        failure: str | None = None
+        mode = "walk"
+        replan_until = -np.inf
+        next_progress = 0.0
+        distance = max(float(np.linalg.norm(goal - monitor.start_centroid)), 1e-9)
+        limit = cfg.outcome.time_limit_s
+        while True:
+            now = measured.time
+            desired, waiting, started = self.buffer.advance(now)
+            current = self.buffer.current
+            if started and current is not None and current.kind == "step":
+                monitor.start_clock(self.buffer.started_at)
+                if self._step_index:
+                    steps_done += 1
+                self._step_index = current.step
+                log.event(
+                    now,
+                    "step",
+                    step=current.step,
+                    leg=current.info.get("leg"),
+                    valid=current.info.get("valid"),
+                )
+                self._schedule_next(now)
+            if desired is None:
+                break
+            if current is None and not self.buffer.queued:
+                if mode == "recovery":
+                    # Settled on four feet: re-plan from where they stand (§6, §4.5).
+                    replans += 1
+                    ok, charged = self._replan(measured, desired, goal, now)
+                    replan_until = now + charged
+                    if not ok:
+                        failure = "re-planning failed: " + (log.events[-1].get("reason") or "")
+                        break
+                    mode = "replan"
+                elif self._plan is not None and self._plan.exhausted:
+                    break
+            if mode == "replan" and now >= replan_until - 1e-9:
+                mode = "walk"
+            if mode in ("walk", "wait"):
+                mode = "wait" if waiting else "walk"
+            if mode == "wait" and monitor.first_motion is not None:
+                wait_s += dt
+            if mode == "replan":
+                replan_s += dt
+            if mode in ("walk", "wait") and monitor.first_motion is not None:
+                trigger = self.reflexes.check(desired, measured)
+                if trigger is not None:
+                    reflexes += 1
+                    log.event(
+                        now,
+                        "reflex",
+                        trigger=trigger.kind,
+                        value=trigger.value,
+                        threshold=trigger.threshold,
+                        leg=trigger.leg,
+                        detail=trigger.describe(),
+                    )
+                    if reflexes > cfg.reflex.max_reflexes:
+                        failure = f"gave up after {cfg.reflex.max_reflexes} reflexes"
+                        break
+                    desired = self._start_recovery(measured, desired, now)
+                    mode = "recovery"
+            q_cmd = self.integrator.update(desired, measured)
+            command = self.controller.command(q_cmd, desired, measured)
+            for disturbance in self.disturbances:
+                disturbance.apply(self.world, now, monitor.first_motion, log)
+            qpos = self.world.data.qpos.copy()
+            log.record(
+                qpos,
+                measured,
+                desired,
+                self.runner.target if self.runner.target is not None else q_cmd,
+                self.integrator.delta,
+                self.controller.stiffness,
+                mode,
+            )
+            measured = self.runner.step(command)
+            monitor.update(measured, desired)
+            if monitor.fell:
+                log.event(measured.time, "fall", reason=monitor.fall_reason)
+                break
+            if monitor.reached_at is not None and not log.events_of("goal"):
+                log.event(monitor.reached_at, "goal")
+            if measured.time > limit:
+                failure = f"time limit: {limit:.0f} s of simulated time"
+                break
+            if self.progress is not None and measured.time >= next_progress:
+                centroid = measured.feet_centroid[:2]
+                done = 1.0 - float(np.linalg.norm(goal - centroid)) / distance
+                self.progress(measured.time, min(max(done, 0.0), 1.0), mode)
+                next_progress = measured.time + 0.1
+        end = measured.time
+        if self._plan is not None and self._plan.exhausted and failure is None and not monitor.fell:
+            steps_done += 1
+        log.record(
+            self.world.data.qpos.copy(),
+            measured,
+            None,
+            np.asarray(measured.q),
+            self.integrator.delta,
+            self.controller.stiffness,
+            "done",
+        )
+        outcome = monitor.finish(
+            end,
+            reflexes=reflexes,
+            replans=replans,
+            wait_s=wait_s,
+            replan_s=replan_s,
+            steps=steps_done,
+            failure=failure,
+            extra={
+                "max_actuator_force_ratio": float(
+                    np.max(self.runner.max_actuator_force / self.world.torque_limit)
+                ),
+                "max_joint_speed_ratio": self.runner.max_speed_ratio,
+                "first_motion_s": monitor.first_motion,
+                "reached_at_s": monitor.reached_at,
+                "end_s": end,
+            },
+        )
+        log.event(end, "end", success=outcome.success, reason=outcome.reason)
+        log.meta["outcome"] = outcome.to_dict()
+        return outcome
+
+    def _schedule_next(self, now: float) -> None:
+        """Footstep k started: optimise k+1 now, ready after its charged wall time."""
+        plan = self._plan
+        if plan is None or plan.exhausted:
+            return
+        traj, wall = self._next_step(plan)
+        if traj is None:
+            return
+        ready = now + self._charge(wall)
+        self.buffer.append(Segment.from_footstep(traj, ready_at=ready))
+        self.log.event(
+            now,
+            "optimized",
+            step=int(traj.step),
+            wall_s=wall,
+            ready_at=ready,
+            valid=bool(traj.valid),
+        )
+
+    def _next_leg(self, desired: DesiredState) -> int | None:
+        """The leg to move first after a reflex: the swing leg if not yet landed, else the next."""
+        plan = self._plan
+        if plan is None or self._step_index < 1:
+            return None
+        k = self._step_index - 1
+        leg = plan.legs[k] if k < len(plan.legs) else None
+        if leg is not None and not desired.support[leg]:
+            return int(leg)
+        return int(plan.legs[k + 1]) if k + 1 < len(plan.legs) else leg
+
+    def _start_recovery(
+        self, measured: MeasuredState, desired: DesiredState, now: float
+    ) -> DesiredState:
+        """Clear the buffer and queue the reflex's motion; returns the desired state to use now."""
+        cfg = self.config.reflex
+        current = self.buffer.current
+        planned = current.last().feet if current is not None else desired.feet
+        self._reflex_next_leg = self._next_leg(desired)
+        in_contact = measured.foot_forces[:, 2] > 1.0
+        self._plan = None
+        self.buffer.clear()
+        self.integrator.reset()
+        self.reflexes.reset()
+        segments, footholds = recovery_segment(
+            self.robot,
+            self.terrain_for_recovery,
+            measured,
+            planned,
+            in_contact,
+            cfg.lower_s,
+            cfg.settle_s,
+            now,
+        )
+        for s in segments:
+            self.buffer.append(s)
+        self.log.event(now, "recovery", footholds=footholds, feet_down=in_contact)
+        state, _, _ = self.buffer.advance(now)
+        assert state is not None
+        return state
+
+    @property
+    def terrain_for_recovery(self) -> Terrain:
+        """The robot puts its feet down on the terrain it believes in (the planner's)."""
+        return self.planner_terrain
+
+    def _replan(
+        self, measured: MeasuredState, holding: DesiredState, goal: np.ndarray, now: float
+    ) -> tuple[bool, float]:
+        """Re-plan from the feet where they stand; queue a blend and the new plan's first step.
+
+        Returns whether a plan came, and the simulated time [s] charged.
+        """
+        budget = self.config.reflex.replan_budget_s
+        start = PlanStart(
+            feet=measured.feet.copy(), next_leg=getattr(self, "_reflex_next_leg", None)
+        )
+        plan, attempt, wall = self._make_plan(start, goal, budget)
+        first = None
+        if plan is not None:
+            first, wall2 = self._next_step(plan)
+            wall += wall2
+        charged = self._charge(wall)
+        next_leg = start.next_leg
+        self.log.event(
+            now,
+            "replan",
+            status=attempt.status,
+            wall_s=wall,
+            charged_s=charged,
+            next_leg=LEG_NAMES[next_leg] if next_leg is not None else None,
+            reason=attempt.reason if plan is None else "",
+        )
+        if plan is None:
+            return False, charged
+        self._plan = plan
+        self._step_index = 0
+        if first is None:
+            plan.exhausted = True
+            return True, charged
+        segment = Segment.from_footstep(first)
+        ready = now + charged
+        self.buffer.append(hold_segment(holding, max(charged, 1e-3), now, kind="hold"))
+        self.buffer.append(blend_segment(self.robot, holding, segment.sample(0.0), 0.2, ready))
+        self.buffer.append(segment.with_ready_at(ready))
+        return True, charged

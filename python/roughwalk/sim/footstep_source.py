@@ -1,0 +1,269 @@
+"""Where the executor's footstep plans come from: the anytime planner, or a blind crawl.
+
+The executor asks for a plan twice in a run's life: before the clock starts
+(from a trunk pose) and after every reflex (from the feet where they stand,
+Zucker 2011, §6: "after recovery stabilizes the dog, the footstep planner is
+re-started"). :class:`PlannerSource` wraps the footstep planner of
+:mod:`roughwalk.planning`; :class:`CrawlSource` is a terrain-blind straight
+crawl for flat-ground tests and for machines where the planner is missing.
+Both return plans in the format :func:`roughwalk.footstep_trajectories`
+reads: footsteps as contact points on the terrain, initial stance first;
+certificates (with foot-sphere centres on the terrain) where there are.
+A :class:`PlanStart` from the feet holds foot-sphere centres, as measured.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roughwalk.errors import InvalidArgumentError
+from roughwalk.robots.canonical_frame import LEG_NAMES
+from roughwalk.trajectories.body_keyframes import nominal_fit, pose_over_support
+from roughwalk.trajectories.whole_body import WholeBody
+
+if TYPE_CHECKING:
+    from roughwalk.robots.robot import Robot
+    from roughwalk.terrain.terrain import Terrain
+
+__all__ = [
+    "PlanStart",
+    "PlanAttempt",
+    "FootstepSource",
+    "CrawlSource",
+    "PlannerSource",
+    "default_source",
+    "CRAWL_ORDER",
+]
+
+CRAWL_ORDER = ("LH", "LF", "RH", "RF")
+
+
+@dataclass(frozen=True)
+class PlanStart:
+    """A plan's start: a trunk pose, or the feet where they stand.
+
+    ``pose`` is (x [m], y [m], yaw [rad]); ``feet`` (4, 3) [m], canonical legs,
+    with ``next_leg`` (canonical index) the leg to move first.
+    """
+
+    pose: tuple[float, float, float] | None = None
+    feet: NDArray[np.float64] | None = None
+    next_leg: int | None = None
+
+    def __post_init__(self) -> None:
+        if (self.pose is None) == (self.feet is None):
+            raise InvalidArgumentError("a plan start needs exactly one of pose= or feet=")
+
+
+@dataclass(frozen=True)
+class PlanAttempt:
+    """What a source returned.
+
+    The ``plan`` (None when it failed), its ``status``, a ``reason`` when it
+    failed, and the ``wall_s`` [s] it took.
+    """
+
+    plan: Any
+    status: str
+    reason: str
+    wall_s: float
+
+    @property
+    def ok(self) -> bool:
+        """A plan came back."""
+        return self.plan is not None
+
+
+class FootstepSource(Protocol):
+    """Anything that plans footsteps to a goal."""
+
+    name: str
+
+    def plan(self, start: PlanStart, goal: NDArray[np.float64], time_limit: float) -> PlanAttempt:
+        """Plan from ``start`` to the goal (x, y) [m] within ``time_limit`` [s]."""
+        ...
+
+
+class CrawlSource:
+    """A straight crawl towards the goal, blind to the terrain but for foot heights.
+
+    Each leg in the order LH, LF, RH, RF moves to the nominal footprint
+    advanced along the line to the goal: half a ``stride`` on its first
+    move, a whole one after, until the footprint's centre is on the goal.
+
+    Parameters
+    ----------
+    robot, terrain:
+        What walks where.
+    stride:
+        Foot advance per step [m].
+    support_margin:
+        How far [m] each step's pose keeps the CoM inside the next support triangle.
+    """
+
+    name = "crawl"
+
+    def __init__(
+        self,
+        robot: Robot,
+        terrain: Terrain,
+        stride: float = 0.08,
+        support_margin: float = 0.015,
+    ) -> None:
+        if not (math.isfinite(stride) and stride > 0):
+            raise InvalidArgumentError(f"stride must be a positive length [m], got {stride}")
+        self.robot = robot
+        self.terrain = terrain
+        self.stride = stride
+        self.support_margin = support_margin
+        self._wb = WholeBody(robot)
+
+    def _on_ground(self, xy: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The foot-sphere centre resting on the terrain over ``xy`` (on its highest point)."""
+        r = self.robot.foot_radius
+        angles = np.linspace(0.0, 2 * np.pi, 8, endpoint=False)
+        ring = np.vstack([[0.0, 0.0], 0.7 * r * np.column_stack([np.cos(angles), np.sin(angles)])])
+        z = float(np.max(self.terrain.height(xy[None] + ring))) + r
+        return np.array([xy[0], xy[1], z])
+
+    def _contact(self, leg: int, centre: NDArray[np.float64]) -> dict[str, Any]:
+        """A plan footstep: the contact point, the centre less the radius along the normal."""
+        c = centre - self.robot.foot_radius * self.terrain.normal(centre[None, :2])[0]
+        return {"leg": LEG_NAMES[leg], "x": float(c[0]), "y": float(c[1]), "z": float(c[2])}
+
+    def plan(self, start: PlanStart, goal: NDArray[np.float64], time_limit: float) -> PlanAttempt:
+        """Plan the crawl (instant; ``time_limit`` is not needed)."""
+        began = time.perf_counter()
+        g = np.asarray(goal, dtype=float)[:2]
+        nominal = self.robot.nominal_stance.feet[:, :2]
+        nominal = nominal - nominal.mean(axis=0)
+        if start.pose is not None:
+            x, y, yaw = start.pose
+            c, s = math.cos(yaw), math.sin(yaw)
+            rot0 = np.array([[c, -s], [s, c]])
+            feet = np.array([self._on_ground(np.array([x, y]) + rot0 @ f) for f in nominal])
+        else:
+            assert start.feet is not None
+            feet = np.asarray(start.feet, dtype=float).copy()
+        centroid = feet[:, :2].mean(axis=0)
+        to_goal = g - centroid
+        distance = float(np.linalg.norm(to_goal))
+        heading = math.atan2(to_goal[1], to_goal[0]) if distance > 1e-9 else 0.0
+        c, s = math.cos(heading), math.sin(heading)
+        rot = np.array([[c, -s], [s, c]])
+        direction = rot[:, 0]
+        order = [LEG_NAMES.index(n) for n in CRAWL_ORDER]
+        first = order.index(start.next_leg) if start.next_leg in order else 0
+        order = order[first:] + order[:first]
+        footsteps = [self._contact(i, feet[i]) for i in range(4)]
+        advance = np.full(4, -1.0)
+        sequence: list[tuple[int, NDArray[np.float64]]] = []
+        k = 0
+        limit = 4 * (int(distance / self.stride) + 3)
+        while np.any(advance < distance - 1e-9) and k < limit:
+            leg = order[k % 4]
+            k += 1
+            if advance[leg] >= distance - 1e-9:
+                continue
+            step = 0.5 * self.stride if advance[leg] < 0 else self.stride
+            advance[leg] = min(max(advance[leg], 0.0) + step, distance)
+            target = self._on_ground(centroid + rot @ nominal[leg] + advance[leg] * direction)
+            sequence.append((leg, target))
+        # Certificate-like poses, as a certificate search starts them (Zucker 2011,
+        # §4.4): the nominal stance fitted to the feet, the CoM nudged into the
+        # next step's support triangle.
+        certificates = []
+        for i, (leg, target) in enumerate(sequence):
+            feet = feet.copy()
+            feet[leg] = target
+            footsteps.append(self._contact(leg, target))
+            following = sequence[i + 1][0] if i + 1 < len(sequence) else order[(k + i) % 4]
+            support = [j for j in range(4) if j != following]
+            fit = nominal_fit(self._wb, feet)
+            frame = pose_over_support(self._wb, feet, support, self.support_margin, start=fit)
+            certificates.append(
+                {
+                    "step": i + 1,
+                    "base_pos": frame.base_pos.tolist(),
+                    "base_quat": frame.base_quat.tolist(),
+                    "q": self.robot.from_canonical(frame.q.reshape(12)).tolist(),
+                }
+            )
+        plan = {
+            "robot": self.robot.name,
+            "terrain": self.terrain.spec,
+            "footsteps": footsteps,
+            "certificates": certificates,
+        }
+        return PlanAttempt(plan, "EXACT", "", time.perf_counter() - began)
+
+
+class PlannerSource:
+    """The anytime footstep planner of :mod:`roughwalk.planning` (Zucker 2011, §4).
+
+    Its precomputation (signed distance field, terrain cost maps) happens
+    once, here, before any run starts (§4.5: "precomputation is also key");
+    re-plans reuse it and the certificates already found.
+
+    Parameters
+    ----------
+    robot, terrain:
+        What walks where (``terrain`` is what the planner sees, which a
+        disturbance may have made wrong).
+    expansions:
+        A budget of expanded states on top of the time limit: the planner's
+        deterministic mode (same inputs and budget, same plan), for tests.
+    options:
+        Passed on to :class:`~roughwalk.planning.footstep_planner.FootstepPlanner`.
+    """
+
+    name = "planner"
+
+    def __init__(
+        self, robot: Robot, terrain: Terrain, expansions: int | None = None, **options: Any
+    ) -> None:
+        from roughwalk.planning.footstep_planner import FootstepPlanner
+
+        self.robot = robot
+        self.terrain = terrain
+        self.expansions = expansions
+        self.planner = FootstepPlanner(robot, terrain, **options)
+
+    def plan(self, start: PlanStart, goal: NDArray[np.float64], time_limit: float) -> PlanAttempt:
+        """Plan within ``time_limit`` [s]; the best plan found by then is returned."""
+        began = time.perf_counter()
+        g = np.asarray(goal, dtype=float)[:2]
+        if start.pose is not None:
+            result = self.planner.plan(
+                start.pose, g, time_limit=time_limit, expansions=self.expansions
+            )
+        else:
+            assert start.feet is not None
+            leg = LEG_NAMES[start.next_leg] if start.next_leg is not None else "LH"
+            result = self.planner.replan(
+                start.feet, leg, goal=g, time_limit=time_limit, expansions=self.expansions
+            )
+        wall = time.perf_counter() - began
+        if not result.solved:
+            reason = result.reason or f"the planner found no plan ({result.status})"
+            return PlanAttempt(None, result.status, reason, wall)
+        return PlanAttempt(result, result.status, "", wall)
+
+
+def default_source(robot: Robot, terrain: Terrain, **options: Any) -> FootstepSource:
+    """The footstep planner when this installation has it, else :class:`CrawlSource`.
+
+    The planner needs the compiled core's ``FootstepPlanner``; a build that
+    predates it falls back to the crawl, which only suits flat ground.
+    """
+    from roughwalk import _core
+
+    if not hasattr(_core, "FootstepPlanner"):
+        return CrawlSource(robot, terrain)
+    return PlannerSource(robot, terrain, **options)

@@ -1,0 +1,257 @@
+"""Segments the executor makes itself: the reflex's recovery, holds and blends.
+
+The reflex (Zucker 2011, §6) must "restore the robot's balance and place
+all four feet firmly on the ground". :func:`recovery_segment` does it in
+three parts, from the measured state:
+
+1. every foot off the ground goes down, fast: straight below where it is
+   (to its planned foothold if that is within 2 cm); the trunk holds still;
+2. the trunk moves over the four feet, to the nominal stance fitted to them
+   (its centre of mass then near the middle of the support polygon);
+3. it holds still so the robot settles before re-planning.
+
+Motions are minimum-jerk in joint angles and trunk pose, long enough that
+no joint exceeds half its velocity limit.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roughwalk.robots._rotations import quat_to_matrix
+from roughwalk.sim.trajectory_buffer import DesiredState, Segment
+from roughwalk.trajectories.body_keyframes import nominal_fit
+from roughwalk.trajectories.contact_forces import static_contact_forces
+from roughwalk.trajectories.euler import matrix_to_rpy, rpy_to_quat
+from roughwalk.trajectories.whole_body import WholeBody
+
+if TYPE_CHECKING:
+    from roughwalk.robots.robot import Robot
+    from roughwalk.sim.measured_state import MeasuredState
+    from roughwalk.terrain.terrain import Terrain
+
+__all__ = ["recovery_segment", "hold_segment", "blend_segment", "pose_segment", "min_jerk"]
+
+_RATE_HZ = 100.0
+_GRAVITY = 9.81
+
+
+def min_jerk(s: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The minimum-jerk profile 10s³ − 15s⁴ + 6s⁵ on [0, 1] (peak slope 1.875)."""
+    return s**3 * (10.0 - 15.0 * s + 6.0 * s**2)
+
+
+def _duration(robot: Robot, q: NDArray[np.float64], at_least: float, speed: float) -> float:
+    """Time [s] for the joint path q (n, 12), min-jerk, at ≤ ``speed`` × the velocity limits."""
+    travel = np.abs(np.diff(q, axis=0)).sum(axis=0)
+    need = float(np.max(1.875 * travel / (speed * np.asarray(robot.joint_velocity_limit))))
+    return max(at_least, need)
+
+
+def _forces(
+    robot: Robot,
+    q: NDArray[np.float64],
+    base_pos: NDArray[np.float64],
+    base_quat: NDArray[np.float64],
+    feet: NDArray[np.float64],
+    support: NDArray[np.bool_],
+) -> NDArray[np.float64]:
+    """Static ground forces (n, 4, 3) [N] holding the robot's weight over its CoM."""
+    com = np.array([robot.center_of_mass(q[k], base_pos[k], base_quat[k]) for k in range(len(q))])
+    zero = np.zeros((len(q), 3))
+    return static_contact_forces(feet, support, com[:, :2], zero, robot.mass, _GRAVITY)
+
+
+def pose_segment(
+    robot: Robot,
+    base_pos: NDArray[np.float64],
+    base_rpy: NDArray[np.float64],
+    feet: NDArray[np.float64],
+    support: NDArray[np.bool_],
+    duration: float,
+    kind: str,
+    ready_at: float,
+    speed: float = 0.5,
+) -> Segment:
+    """A segment through trunk poses (n, 3)+(n, 3) [m, rad] and feet (n, 4, 3) [m], timed by IK.
+
+    The samples are spread over ``duration`` [s] (or longer if a joint would
+    pass ``speed`` × its velocity limit) with minimum-jerk timing; q comes
+    from IK at every sample.
+    """
+    n = len(base_pos)
+    quats = np.array([rpy_to_quat(a) for a in base_rpy])
+    q = np.array([robot.inverse_kinematics(feet[k], base_pos[k], quats[k])[0] for k in range(n)])
+    total = _duration(robot, q, duration, speed)
+    m = max(int(np.ceil(total * _RATE_HZ)), 1)
+    t = np.linspace(0.0, total, m + 1)
+    s = min_jerk(t / total) * (n - 1)
+    lo = np.clip(np.floor(s).astype(int), 0, max(n - 2, 0))
+    a = (s - lo)[:, None]
+    hi = np.minimum(lo + 1, n - 1)
+
+    def lerp(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        flat = x.reshape(n, -1)
+        return ((1.0 - a) * flat[lo] + a * flat[hi]).reshape((m + 1, *x.shape[1:]))
+
+    qs = lerp(q)
+    pos = lerp(base_pos)
+    rpy = lerp(base_rpy)
+    quat = np.array([rpy_to_quat(r) for r in rpy])
+    fs = lerp(feet)
+    sup = np.repeat(np.asarray(support, dtype=bool)[None], m + 1, axis=0)
+    qd = np.gradient(qs, t, axis=0) if m > 1 else np.zeros_like(qs)
+    return Segment(
+        t=t,
+        q=qs,
+        qd=qd,
+        base_pos=pos,
+        base_quat=quat,
+        feet=fs,
+        support=sup,
+        forces=_forces(robot, qs, pos, quat, fs, sup),
+        phase=np.zeros(m + 1, dtype=np.int64),
+        kind=kind,
+        ready_at=ready_at,
+    )
+
+
+def hold_segment(
+    state: DesiredState, duration: float, ready_at: float, kind: str = "hold"
+) -> Segment:
+    """Hold ``state`` for ``duration`` [s]."""
+    m = max(int(np.ceil(duration * _RATE_HZ)), 1)
+    t = np.linspace(0.0, max(duration, 1e-3), m + 1)
+
+    def rep(x: NDArray[Any]) -> NDArray[Any]:
+        return np.repeat(np.asarray(x)[None], m + 1, axis=0)
+
+    return Segment(
+        t=t,
+        q=rep(state.q),
+        qd=np.zeros((m + 1, 12)),
+        base_pos=rep(state.base_pos),
+        base_quat=rep(state.base_quat),
+        feet=rep(state.feet),
+        support=rep(state.support),
+        forces=rep(state.forces),
+        phase=np.zeros(m + 1, dtype=np.int64),
+        kind=kind,
+        step=state.step,
+        ready_at=ready_at,
+    )
+
+
+def blend_segment(
+    robot: Robot,
+    start: DesiredState,
+    end: DesiredState,
+    at_least: float,
+    ready_at: float,
+) -> Segment:
+    """Move from ``start`` to ``end`` (both with four feet down) in trunk pose, feet following.
+
+    Used where a new plan begins from a pose that differs slightly from the
+    one the robot holds.
+    """
+    k = 11
+    s = np.linspace(0.0, 1.0, k)[:, None]
+    rpy0 = matrix_to_rpy(quat_to_matrix(start.base_quat))
+    rpy1 = matrix_to_rpy(quat_to_matrix(end.base_quat))
+    rpy1 = rpy0 + (rpy1 - rpy0 + np.pi) % (2 * np.pi) - np.pi
+    feet = (1.0 - s[:, :, None]) * start.feet[None] + s[:, :, None] * end.feet[None]
+    return pose_segment(
+        robot,
+        (1.0 - s) * start.base_pos + s * end.base_pos,
+        (1.0 - s) * rpy0 + s * rpy1,
+        feet,
+        np.ones(4, dtype=bool),
+        at_least,
+        "blend",
+        ready_at,
+    )
+
+
+def recovery_segment(
+    robot: Robot,
+    terrain: Terrain,
+    measured: MeasuredState,
+    planned_feet: NDArray[np.float64],
+    in_contact: NDArray[np.bool_],
+    lower_s: float,
+    settle_s: float,
+    ready_at: float,
+) -> tuple[list[Segment], NDArray[np.float64]]:
+    """The reflex's motion from ``measured``: feet down, trunk over them, hold.
+
+    Parameters
+    ----------
+    planned_feet:
+        (4, 3) [m] where each foot was headed (its planned foothold).
+    in_contact:
+        (4,) which feet bear weight now; the others are put down.
+    lower_s:
+        Time [s] for the first two parts together (stretched if a joint needs it).
+    settle_s:
+        Hold time [s] at the end.
+
+    Returns the segments and the four footholds (4, 3) [m] the robot ends on.
+    """
+    r = robot.foot_radius
+    base = measured.base_pos
+    rpy = matrix_to_rpy(measured.rotation)
+    start_feet = measured.feet.copy()
+    target = start_feet.copy()
+    for leg in np.flatnonzero(~np.asarray(in_contact, dtype=bool)):
+        # Straight down is the quickest catch; the planned foothold only when
+        # the foot is nearly over it already.
+        goal = np.asarray(planned_feet[leg], dtype=float).copy()
+        if np.linalg.norm(goal[:2] - start_feet[leg, :2]) > 0.02:
+            goal = start_feet[leg].copy()
+        goal[2] = float(terrain.height(goal[None, :2])[0]) + r
+        target[leg] = goal
+    # Part 1, fast: the lifted feet down (with a 1.5 cm arch if they move
+    # across), trunk still; the robot may be tipping towards them.
+    k = 9
+    s = np.linspace(0.0, 1.0, k)
+    feet = (1.0 - s)[:, None, None] * start_feet[None] + s[:, None, None] * target[None]
+    arch = 0.015 * np.sin(np.pi * s)
+    moving = np.linalg.norm(target[:, :2] - start_feet[:, :2], axis=1) > 0.02
+    feet[:, moving, 2] += arch[:, None]
+    support = np.asarray(in_contact, dtype=bool)
+    segments = []
+    if np.any(~support):
+        segments.append(
+            pose_segment(
+                robot,
+                np.repeat(base[None], k, axis=0),
+                np.repeat(rpy[None], k, axis=0),
+                feet,
+                support,
+                0.25 * lower_s,
+                "recovery",
+                ready_at,
+                speed=1.0,
+            )
+        )
+    # Part 2: the trunk over the four feet, nominal stance fitted to them.
+    fit_pos, fit_rpy = nominal_fit(WholeBody(robot), target)
+    fit_rpy = rpy + (fit_rpy - rpy + np.pi) % (2 * np.pi) - np.pi
+    s2 = np.linspace(0.0, 1.0, k)[:, None]
+    segments.append(
+        pose_segment(
+            robot,
+            (1.0 - s2) * base + s2 * fit_pos,
+            (1.0 - s2) * rpy + s2 * fit_rpy,
+            np.repeat(target[None], k, axis=0),
+            np.ones(4, dtype=bool),
+            0.75 * lower_s,
+            "recovery",
+            ready_at,
+        )
+    )
+    segments.append(hold_segment(segments[-1].last(), settle_s, ready_at, kind="recovery"))
+    return segments, target

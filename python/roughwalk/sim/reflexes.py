@@ -1,0 +1,131 @@
+"""The :class:`ReflexMonitor`: execution errors large enough to stop walking (Zucker 2011, §6).
+
+"Execution errors larger than a certain threshold trigger a reflex module
+which attempts to restore the robot's balance and place all four feet
+firmly on the ground. The reflex module can be triggered by body position
+or orientation errors, foot position errors, or foot force errors."
+
+Each error must persist for :attr:`ReflexConfig.persist_s` so that the
+transients of a touchdown do not fire it. The recovery motion itself is
+:func:`roughwalk.sim.recovery.recovery_segment`; the executor then re-plans.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from roughwalk.robots._rotations import quat_multiply
+from roughwalk.robots.canonical_frame import LEG_NAMES
+from roughwalk.sim.config import ReflexConfig
+
+if TYPE_CHECKING:
+    from roughwalk.sim.measured_state import MeasuredState
+    from roughwalk.sim.trajectory_buffer import DesiredState
+
+__all__ = ["ReflexMonitor", "ReflexTrigger", "orientation_error"]
+
+_KINDS = ("body_position", "body_orientation", "foot_position", "foot_force")
+
+
+@dataclass(frozen=True)
+class ReflexTrigger:
+    """Why a reflex fired.
+
+    ``kind`` is one of body_position, body_orientation, foot_position,
+    foot_force; ``value`` and ``threshold`` are in SI units; ``leg`` is the
+    leg concerned (or None); ``time`` the simulated time [s].
+    """
+
+    kind: str
+    value: float
+    threshold: float
+    leg: str | None
+    time: float
+
+    def describe(self) -> str:
+        """One line for logs and reports."""
+        where = f" ({self.leg})" if self.leg else ""
+        return f"{self.kind}{where}: {self.value:.3g} beyond {self.threshold:.3g}"
+
+
+def orientation_error(a: np.ndarray, b: np.ndarray) -> float:
+    """Angle [rad] of the rotation between orientations ``a`` and ``b`` (w, x, y, z)."""
+    rel = quat_multiply(a, b * np.array([1.0, -1.0, -1.0, -1.0]))
+    return float(2.0 * np.arccos(np.clip(abs(rel[0]), 0.0, 1.0)))
+
+
+class ReflexMonitor:
+    """Compares the measured state with the desired one every tick."""
+
+    def __init__(self, config: ReflexConfig | None = None) -> None:
+        self.config = config if config is not None else ReflexConfig()
+        self._since: dict[str, float | None] = dict.fromkeys(_KINDS)
+        self._down_since = np.full(4, np.inf)
+
+    def reset(self) -> None:
+        """Forget persisting errors (after a reflex, or when a new plan starts)."""
+        self._since = dict.fromkeys(_KINDS)
+        self._down_since[:] = np.inf
+
+    def errors(
+        self, desired: DesiredState, measured: MeasuredState
+    ) -> dict[str, tuple[float, float, str | None]]:
+        """Each error's (value, threshold, leg) at this instant (the worst leg for foot errors)."""
+        cfg = self.config
+        now = measured.time
+        down = desired.support
+        # A foot's position and force are judged once it has been down a while:
+        # a landing a few millimetres off is not a slip.
+        self._down_since = np.where(down, np.minimum(self._down_since, now), np.inf)
+        settled = down & (now - self._down_since >= 2 * cfg.persist_s)
+        out: dict[str, tuple[float, float, str | None]] = {
+            "body_position": (
+                float(np.linalg.norm(measured.base_pos - desired.base_pos)),
+                cfg.body_position_m,
+                None,
+            ),
+            "body_orientation": (
+                orientation_error(measured.base_quat, desired.base_quat),
+                cfg.body_orientation_rad,
+                None,
+            ),
+        }
+        foot_error = np.where(settled, np.linalg.norm(measured.feet - desired.feet, axis=1), 0.0)
+        worst = int(np.argmax(foot_error))
+        out["foot_position"] = (float(foot_error[worst]), cfg.foot_position_m, LEG_NAMES[worst])
+        planned = desired.forces[:, 2]
+        # With four feet down the load sharing is statically indeterminate: a
+        # foot a millimetre high carries nothing and the robot is still fine.
+        # With three, a planned load the foot does not carry means tipping.
+        determinate = bool(np.sum(down) == 3)
+        loaded = settled & (planned >= cfg.foot_force_n) & determinate
+        shortfall = np.where(loaded, planned - measured.foot_forces[:, 2], 0.0)
+        limit = np.where(loaded, (1.0 - cfg.foot_force_fraction) * planned, np.inf)
+        ratio = shortfall / limit
+        worst = int(np.argmax(ratio))
+        out["foot_force"] = (
+            float(shortfall[worst]),
+            float(limit[worst]) if np.isfinite(limit[worst]) else float("inf"),
+            LEG_NAMES[worst],
+        )
+        return out
+
+    def check(self, desired: DesiredState, measured: MeasuredState) -> ReflexTrigger | None:
+        """The trigger if an error has stayed beyond its threshold long enough, else None."""
+        if not self.config.enabled:
+            return None
+        now = measured.time
+        fired: ReflexTrigger | None = None
+        for kind, (value, threshold, leg) in self.errors(desired, measured).items():
+            if value > threshold:
+                since = self._since[kind]
+                if since is None:
+                    self._since[kind] = since = now
+                if fired is None and now - since >= self.config.persist_s - 1e-12:
+                    fired = ReflexTrigger(kind, value, threshold, leg, now)
+            else:
+                self._since[kind] = None
+        return fired

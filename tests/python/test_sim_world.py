@@ -1,0 +1,282 @@
+"""The simulation's pieces: world, runner, buffer, integrators, reflex triggers."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+import roughwalk
+from roughwalk.errors import ConfigError, InvalidArgumentError
+from roughwalk.robots.registry import list_robots
+from roughwalk.sim.config import IntegratorConfig, ReflexConfig, WorldConfig
+from roughwalk.sim.joint_controller import JointController
+from roughwalk.sim.leg_integrator import LegIntegrator
+from roughwalk.sim.recovery import hold_segment, pose_segment
+from roughwalk.sim.reflexes import ReflexMonitor
+from roughwalk.sim.runner import Runner, ServoCommand
+from roughwalk.sim.trajectory_buffer import Segment, TrajectoryBuffer
+from roughwalk.sim.world import World
+from roughwalk.terrain import list_generators
+
+
+@pytest.fixture(scope="module")
+def littledog() -> roughwalk.Robot:
+    return roughwalk.load_robot("littledog")
+
+
+@pytest.fixture(scope="module")
+def flat() -> roughwalk.Terrain:
+    return roughwalk.load_terrain("flat")
+
+
+def standing_segment(robot: roughwalk.Robot, xy: tuple[float, float] = (0.5, 0.0)) -> Segment:
+    """Hold the nominal stance with the trunk over (x, y) on flat ground."""
+    st = robot.nominal_stance
+    base = np.array([xy[0], xy[1], st.base_height])
+    feet = st.feet + base
+    return pose_segment(
+        robot,
+        np.array([base, base]),
+        np.zeros((2, 3)),
+        np.array([feet, feet]),
+        np.ones(4, dtype=bool),
+        1.0,
+        "hold",
+        0.0,
+    )
+
+
+@pytest.mark.parametrize("robot_name", [r.name for r in list_robots()])
+def test_world_compiles_and_steps_for_every_robot_and_generator(robot_name: str) -> None:
+    # The contract over every registered robot and terrain generator: build,
+    # reset, step under the servos, no NaN, and the robot ends up standing.
+    robot = roughwalk.load_robot(robot_name)
+    stance = robot.nominal_stance
+    for info in list_generators():
+        terrain = roughwalk.load_terrain(info.name)
+        world = World(robot, terrain)
+        runner = Runner(world)
+        x0, x1, y0, y1 = terrain.extent
+        x, y = x0 + 0.3 * (x1 - x0), 0.5 * (y0 + y1)
+        ground = float(terrain.height(np.array([[x, y]]))[0])
+        runner.reset(robot.nominal_q, [x, y, ground + stance.base_height + 0.02], [1, 0, 0, 0])
+        hold = ServoCommand(robot.nominal_q, np.zeros(12), np.zeros(12), np.ones(12))
+        for _ in range(100):
+            state = runner.step(hold)
+        assert np.all(np.isfinite(world.data.qpos)), (robot_name, info.name)
+        assert np.all(np.isfinite(state.foot_forces)), (robot_name, info.name)
+        assert state.base_pos[2] > terrain.height_range[0], (robot_name, info.name)
+        # Same joints, same order as the robot's own model.
+        assert world.model.nq == robot.mj_model().nq
+
+
+def test_world_keeps_the_robots_actuators_and_limits(littledog, flat) -> None:
+    world = World(littledog, flat)
+    np.testing.assert_allclose(world.torque_limit, littledog.joint_torque_limit)
+    own = littledog.mj_model()
+    assert world.model.nu == own.nu
+    np.testing.assert_allclose(world.model.actuator_forcerange, own.actuator_forcerange)
+    # The terrain is one height-field geom whose surface is the terrain's.
+    assert world.model.ngeom == own.ngeom + 1
+    assert world.model.geom_type[world.roles.terrain] == mujoco.mjtGeom.mjGEOM_HFIELD
+    assert set(world.roles.leg[world.roles.foot]) == {0, 1, 2, 3}
+    assert len(world.roles.trunk) >= 1
+
+
+def test_physics_step_is_an_integer_fraction_of_the_control_period(littledog, flat) -> None:
+    cfg = WorldConfig(physics_hz=2000.0, control_hz=500.0)
+    assert cfg.substeps == 4
+    world = World(littledog, flat, cfg)
+    assert world.physics_dt == pytest.approx(0.0005)
+    assert world.control_dt == pytest.approx(0.002)
+    runner = Runner(world)
+    seg = standing_segment(littledog)
+    runner.reset(seg.q[0], seg.base_pos[0], seg.base_quat[0])
+    hold = ServoCommand(seg.q[0], np.zeros(12), np.zeros(12), np.ones(12))
+    for k in range(1, 11):
+        state = runner.step(hold)
+        assert state.time == pytest.approx(k * 0.002, abs=1e-12)
+    with pytest.raises(ConfigError, match="integer multiple"):
+        WorldConfig(physics_hz=1000.0, control_hz=300.0)
+    with pytest.raises(ConfigError, match="timeconst"):
+        WorldConfig(physics_hz=200.0, control_hz=100.0)
+
+
+def test_contact_forces_carry_the_robots_weight(littledog, flat) -> None:
+    world = World(littledog, flat)
+    runner = Runner(world)
+    seg = standing_segment(littledog)
+    runner.reset(seg.q[0], seg.base_pos[0], seg.base_quat[0])
+    hold = ServoCommand(seg.q[0], np.zeros(12), np.zeros(12), np.ones(12))
+    for _ in range(300):
+        state = runner.step(hold)
+    total = state.foot_forces.sum(axis=0)
+    weight = littledog.mass * 9.81
+    assert total[2] == pytest.approx(weight, rel=0.02)
+    assert abs(total[0]) < 0.02 * weight and abs(total[1]) < 0.02 * weight
+    assert np.all(state.foot_forces[:, 2] > 0.1 * weight)
+    assert not state.trunk_contact and not np.any(state.shin_contact)
+
+
+def test_torque_limits_hold_even_when_the_servos_demand_more(littledog, flat) -> None:
+    world = World(littledog, flat)
+    runner = Runner(world)
+    seg = standing_segment(littledog)
+    runner.reset(seg.q[0], seg.base_pos[0], seg.base_quat[0])
+    # A target 0.5 rad away asks kp·0.5 = 12.5 N·m of every joint: 5-9× the limits.
+    target = seg.q[0] + 0.5 * np.sign(littledog.nominal_q + 1e-3)
+    command = ServoCommand(target, np.zeros(12), np.zeros(12), np.ones(12))
+    runner._target = target.copy()  # skip the rate limiter: a step demand
+    peaks = np.zeros(12)
+    for _ in range(5):
+        state = runner.step(command)
+        peaks = np.maximum(peaks, np.abs(state.actuator_force))
+    limit = littledog.joint_torque_limit
+    assert np.all(runner.max_actuator_force <= limit + 1e-9)
+    # The limit is reached, so the clamp (not a small demand) is what held it.
+    np.testing.assert_allclose(peaks, limit, rtol=1e-9)
+
+
+def test_runner_limits_the_commanded_joint_speed(littledog, flat) -> None:
+    world = World(littledog, flat)
+    runner = Runner(world)
+    seg = standing_segment(littledog)
+    runner.reset(seg.q[0], seg.base_pos[0], seg.base_quat[0])
+    jump = seg.q[0] + 0.3
+    before = runner.target
+    runner.step(ServoCommand(jump, np.zeros(12), np.zeros(12), np.ones(12)))
+    moved = np.abs(runner.target - before)
+    np.testing.assert_allclose(moved, littledog.joint_velocity_limit * world.control_dt)
+
+
+def test_buffer_plays_segments_first_in_first_out_and_waits_for_late_ones(littledog) -> None:
+    seg = standing_segment(littledog)
+    a = hold_segment(seg.sample(0.0), 0.1, 0.0, kind="a")
+    moved = seg.sample(0.0)
+    b_state = type(moved)(**{**moved.__dict__, "q": moved.q + 0.1})
+    b = hold_segment(b_state, 0.1, 0.0, kind="b")
+    buf = TrajectoryBuffer()
+    buf.append(a)
+    buf.append(b.with_ready_at(0.15))
+    kinds, waits = [], []
+    for k in range(200):
+        now = 0.002 * k
+        state, waiting, _ = buf.advance(now)
+        assert state is not None
+        kinds.append(buf.current.kind if buf.current is not None else None)
+        waits.append(waiting)
+    kinds_arr = np.array(kinds, dtype=object)
+    waits_arr = np.array(waits)
+    t = 0.002 * np.arange(200)
+    assert np.all(kinds_arr[t <= 0.1 - 1e-9] == "a")
+    # b is late: the robot holds a's end from 0.1 s to 0.15 s and the wait shows.
+    late = (t > 0.1 + 1e-9) & (t < 0.15 - 1e-9)
+    assert np.all(waits_arr[late]) and np.all(kinds_arr[late] == None)  # noqa: E711
+    assert np.all(kinds_arr[(t >= 0.15) & (t <= 0.25 - 1e-9)] == "b")
+    assert len(buf) == 0
+
+
+def test_segment_knows_the_time_to_each_touchdown(littledog) -> None:
+    seg = standing_segment(littledog)
+    n = 11
+    t = np.linspace(0.0, 1.0, n)
+    support = np.ones((n, 4), dtype=bool)
+    support[2:7, 1] = False  # RF in flight from t = 0.2 to 0.6, down again at 0.7
+    s = Segment(
+        t=t,
+        q=np.repeat(seg.q[:1], n, 0),
+        qd=np.zeros((n, 12)),
+        base_pos=np.repeat(seg.base_pos[:1], n, 0),
+        base_quat=np.repeat(seg.base_quat[:1], n, 0),
+        feet=np.repeat(seg.feet[:1], n, 0),
+        support=support,
+        forces=np.zeros((n, 4, 3)),
+        phase=np.zeros(n, dtype=np.int64),
+    )
+    assert s.sample(0.3).touchdown_in[1] == pytest.approx(0.4)
+    assert s.sample(0.45).touchdown_in[1] == pytest.approx(0.25)
+    assert np.isinf(s.sample(0.3).touchdown_in[0])
+    with pytest.raises(InvalidArgumentError):
+        Segment(
+            t=t[::-1],
+            q=s.q,
+            qd=s.qd,
+            base_pos=s.base_pos,
+            base_quat=s.base_quat,
+            feet=s.feet,
+            support=s.support,
+            forces=s.forces,
+            phase=s.phase,
+        )
+
+
+def _hold_with_load(robot, terrain, integrator_on: bool, seconds: float = 3.0) -> list[float]:
+    """Trunk position error [m] while a constant external force pushes the standing robot."""
+    world = World(robot, terrain)
+    runner = Runner(world)
+    controller = JointController(world)
+    integrator = LegIntegrator(robot, IntegratorConfig(enabled=integrator_on), world.control_dt)
+    desired = standing_segment(robot).sample(0.0)
+    state = runner.reset(desired.q, desired.base_pos, desired.base_quat)
+    errors = []
+    for k in range(int(seconds / world.control_dt)):
+        # The forced offset: 10 N down and 5 N sideways on the trunk from 0.5 s on.
+        world.data.xfrc_applied[world.base_body, :3] = [4.0, 3.0, -10.0] if k >= 250 else 0.0
+        q = integrator.update(desired, state)
+        state = runner.step(controller.command(q, desired, state))
+        errors.append(float(np.linalg.norm(state.base_pos - desired.base_pos)))
+    return errors
+
+
+def test_leg_integrators_reduce_the_body_error_after_a_forced_offset(littledog, flat) -> None:
+    # Zucker 2011, §6: the integrators shorten or lengthen the supporting legs
+    # until the trunk is back where it should be.
+    with_integrators = _hold_with_load(littledog, flat, True)
+    without = _hold_with_load(littledog, flat, False)
+    offset = max(with_integrators[250:300])
+    assert offset > 0.0015  # the force does displace the trunk
+    assert with_integrators[-1] < 0.4 * offset  # and the integrators take it back
+    assert with_integrators[-1] < 0.3 * without[-1]
+
+
+def test_integrator_decays_in_flight_and_follows_the_update_rule(littledog) -> None:
+    integrator = LegIntegrator(littledog, IntegratorConfig(gain=0.01, flight_decay_s=0.05), 0.002)
+    desired = standing_segment(littledog).sample(0.0)
+    support = desired.support.copy()
+    support[3] = False
+    desired = type(desired)(**{**desired.__dict__, "support": support})
+    measured = type("M", (), {})()
+    measured.base_pos = desired.base_pos + np.array([0.0, 0.0, -0.01])  # trunk 1 cm low
+    measured.rotation = np.eye(3)
+    integrator.delta[3] = [0.0, 0.0, 0.02]
+    q = integrator.update(desired, measured)
+    # Supporting legs: Δ = γ(f_B − f̄_B) = 0.01 · (0, 0, −0.01): lengthen the legs.
+    np.testing.assert_allclose(integrator.delta[:3], [[0.0, 0.0, -1e-4]] * 3, atol=1e-12)
+    np.testing.assert_allclose(integrator.delta[3], [0.0, 0.0, 0.02 * np.exp(-0.002 / 0.05)])
+    # q = IK_B(f_B + Δ): the commanded feet sit Δ below the desired ones in the body frame.
+    feet_b = littledog.foot_positions(q)
+    np.testing.assert_allclose(
+        feet_b - littledog.foot_positions(desired.q), integrator.delta, atol=1e-9
+    )
+
+
+def test_reflex_fires_only_on_errors_that_persist(littledog) -> None:
+    monitor = ReflexMonitor(ReflexConfig(body_position_m=0.02, persist_s=0.03))
+    desired = standing_segment(littledog).sample(0.0)
+    measured = type("M", (), {})()
+    measured.feet = desired.feet.copy()
+    measured.foot_forces = desired.forces.copy()
+    measured.base_quat = desired.base_quat.copy()
+    fired = []
+    for k in range(40):
+        measured.time = 0.002 * k
+        # A 1-tick glitch at k = 3, then a lasting 3 cm offset from k = 10.
+        offset = 0.03 if (k == 3 or k >= 10) else 0.0
+        measured.base_pos = desired.base_pos + np.array([0.0, offset, 0.0])
+        trigger = monitor.check(desired, measured)
+        fired.append(trigger)
+    hits = [k for k, f in enumerate(fired) if f is not None]
+    assert hits and hits[0] == 25  # 10 + 0.03 s / 0.002 s
+    assert fired[25].kind == "body_position"
+    assert fired[25].value == pytest.approx(0.03)
