@@ -13,6 +13,7 @@ from roughwalk.errors import (
     RoughwalkError,
     TerrainError,
 )
+from roughwalk.planning.footstep_planner import plan_footsteps
 from roughwalk.robots import Robot, load_robot
 from roughwalk.terrain import Terrain, load_terrain
 from roughwalk.trajopt import optimize_motion
@@ -30,6 +31,7 @@ __all__ = [
     "load_terrain",
     "Robot",
     "load_robot",
+    "plan_footsteps",
     "optimize_motion",
     "footstep_trajectories",
 ]

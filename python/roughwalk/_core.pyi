@@ -1,5 +1,8 @@
 """Type stubs for the compiled module ``roughwalk._core`` (the Rust core's bindings)."""
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -260,3 +263,64 @@ def support_triangle_incircle(
 
 def support_polygon_margin(point: ArrayLike, feet: ArrayLike) -> float:
     """Signed x–y distance [m] from ``point`` to the convex hull of ``feet``: positive inside."""
+
+# ---- footstep planner (crates/roughwalk-py/src/footstep.rs) ---------------------------
+
+class FootstepPlanner:
+    """The footstep planner of one robot on one terrain (Zucker 2011, §4).
+
+    Built once per terrain (SDF, cost maps, lattice) and planned with many
+    times; certificate outcomes are cached across calls.
+    """
+
+    def __init__(
+        self,
+        quadruped: Quadruped,
+        nominal_q: ArrayLike,
+        base_mass: float,
+        base_com: ArrayLike,
+        link_mass: ArrayLike,
+        link_com: ArrayLike,
+        capsule_leg: list[int],
+        capsule_link: list[int],
+        capsule_a: ArrayLike,
+        capsule_b: ArrayLike,
+        capsule_radius: list[float],
+        heightfield: HeightField,
+        sdf_values: NDArray[np.float32],
+        sdf_origin: tuple[float, float, float],
+        sdf_resolution: float,
+        cost_front: ArrayLike,
+        cost_hind: ArrayLike,
+        config: dict[str, Any],
+    ) -> None: ...
+    def plan(
+        self,
+        goal: tuple[float, float],
+        start_pose: tuple[float, float, float] | None = None,
+        start_feet: ArrayLike | None = None,
+        next_leg: int = 2,
+        time_limit: float | None = None,
+        expansions: int | None = None,
+        callback: Callable[[dict[str, Any]], Any] | None = None,
+        search: str = "arastar",
+    ) -> dict[str, Any]:
+        """Plan from a trunk pose or from feet (4, 2) [m] to the disc around ``goal`` [m]."""
+    @property
+    def lattice(self) -> tuple[float, float, float, int, int]:
+        """(x0, y0, resolution, nx, ny) of the foothold lattice [m, m, m, -, -]."""
+    @property
+    def heuristic_scales(self) -> tuple[float, float]:
+        """Cost per metre of the Euclidean and the Dubins heuristic."""
+    @property
+    def sdf_error(self) -> float:
+        """SDF interpolation error bound added to every certified clearance [m]."""
+    @property
+    def nominal_height(self) -> float:
+        """Trunk height over the feet at the nominal stance [m]."""
+    @property
+    def foothold_count(self) -> int:
+        """Foothold cells of the lattice."""
+    @property
+    def cache_len(self) -> int:
+        """Cached certificate outcomes."""

@@ -10,6 +10,7 @@
 use pyo3::prelude::*;
 
 mod errors;
+mod footstep;
 mod heightfield;
 mod robot;
 mod sdf;
@@ -21,5 +22,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     heightfield::register(m)?;
     sdf::register(m)?;
     robot::register(m)?;
+    footstep::register(m)?;
     Ok(())
 }

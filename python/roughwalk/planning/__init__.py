@@ -14,6 +14,10 @@ from roughwalk.planning.cost_learning import (
     cross_validate,
     learn_cost,
 )
+from roughwalk.planning.footstep_config import CertificateConfig, FootstepConfig
+from roughwalk.planning.footstep_cost import default_terrain_cost, hand_set_terrain_cost
+from roughwalk.planning.footstep_plan import Footstep, FootstepPlan
+from roughwalk.planning.footstep_planner import FootstepPlanner, plan_footsteps
 from roughwalk.planning.pair_selection import (
     CandidatePair,
     PairSelectionConfig,
@@ -39,6 +43,14 @@ from roughwalk.planning.terrain_cost import (
 )
 
 __all__ = [
+    "FootstepPlanner",
+    "FootstepPlan",
+    "FootstepConfig",
+    "CertificateConfig",
+    "Footstep",
+    "plan_footsteps",
+    "default_terrain_cost",
+    "hand_set_terrain_cost",
     "TerrainCost",
     "CostModelError",
     "COST_VERSION",

@@ -55,9 +55,14 @@ pub struct CertificateConfig {
     pub beta_obstacle: f64,
     /// The centre of mass must lie this far inside the support triangle [m].
     pub com_margin: f64,
-    /// Longest horizontal nudge of the trunk toward the triangle per
-    /// iteration [m].
-    pub com_max_step: f64,
+    /// Longest trunk translation per round, all corrections together [m].
+    pub max_step: f64,
+    /// Largest trunk rotation per round [rad].
+    pub max_turn: f64,
+    /// The search gives up once the trunk is this far from its guessed
+    /// position [m]: near a singular leg the §3.4 Jacobians blow up and
+    /// would fling it away.
+    pub max_drift: f64,
     /// Least distance between the robot (feet excluded) and the terrain [m].
     pub clearance: f64,
     /// How far past `clearance` the obstacle correction aims [m].
@@ -179,7 +184,9 @@ impl CertificateConfig {
         ] {
             non_negative(name, v)?;
         }
-        positive("certificate.com_max_step", self.com_max_step)?;
+        positive("certificate.max_step", self.max_step)?;
+        positive("certificate.max_turn", self.max_turn)?;
+        positive("certificate.max_drift", self.max_drift)?;
         if !(self.preferred_clearance.is_finite() && self.preferred_clearance >= self.clearance) {
             return Err(CoreError::Planning(format!(
                 "footstep config: certificate.preferred_clearance must be >= clearance ({}), got {}",
@@ -301,10 +308,12 @@ pub(crate) mod tests {
                 alpha_obstacle: 0.7,
                 beta_obstacle: 0.3 / (0.5 * l * 0.5 * l),
                 com_margin: 0.05 * l,
-                com_max_step: 0.25 * l,
+                max_step: 0.1 * l,
+                max_turn: 0.15,
+                max_drift: 0.5 * l,
                 clearance: 0.004,
                 clearance_overshoot: 0.002,
-                preferred_clearance: 0.015,
+                preferred_clearance: 0.01,
                 clearance_penalty: 0.5,
                 singularity_margin: 0.25,
                 singularity_penalty: 0.5,

@@ -15,7 +15,9 @@ use std::hash::{BuildHasherDefault, Hasher};
 use crate::dubins::{dubins_heuristic, euclidean_heuristic};
 use crate::error::{CoreError, CoreResult};
 use crate::footstep::actions::{action_target, LocalSearch};
-use crate::footstep::certificate::{CertificateFailure, CertificateSearch, PoseCertificate};
+use crate::footstep::certificate::{
+    CertificateFailure, CertificateSearch, LegReach, PoseCertificate,
+};
 use crate::footstep::collision::CollisionModel;
 use crate::footstep::config::{FootstepConfig, HeuristicKind};
 use crate::footstep::cost_map::CostMap;
@@ -139,6 +141,7 @@ pub struct FootstepModel {
     euclidean_per_metre: f64,
     dubins_per_metre: f64,
     sdf_error: f64,
+    reach: [LegReach; 4],
     cache: HashMap<FootstepState, Outcome, BuildHasherDefault<FxHasher>>,
     tree: Vec<TreeEdge>,
     counters: ModelCounters,
@@ -200,6 +203,7 @@ impl FootstepModel {
             config.local_search_penalty,
         );
         let sdf_error = 0.5 * 3f64.sqrt() * sdf.grid().spec().resolution;
+        let reach = std::array::from_fn(|i| LegReach::of(&legs[i]));
         Ok(Self {
             robot,
             map,
@@ -214,6 +218,7 @@ impl FootstepModel {
             euclidean_per_metre,
             dubins_per_metre,
             sdf_error,
+            reach,
             cache: HashMap::default(),
             tree: Vec::new(),
             counters: ModelCounters::default(),
@@ -301,6 +306,7 @@ impl FootstepModel {
             nominal_feet_centroid: self.nominal_feet_centroid,
             nominal_com: self.nominal_com,
             sdf_error: self.sdf_error,
+            reach: &self.reach,
         }
     }
 
@@ -378,8 +384,12 @@ impl FootstepModel {
         }
         // No crossing, in the new stance's heading frame.
         let [lf, rf, lh, rh] = feet;
-        let heading = (lf[1] + rf[1] - lh[1] - rh[1]).atan2(lf[0] + rf[0] - lh[0] - rh[0]);
-        let (sn, cs) = heading.sin_cos();
+        let (hx, hy) = (lf[0] + rf[0] - lh[0] - rh[0], lf[1] + rf[1] - lh[1] - rh[1]);
+        let len = hx.hypot(hy);
+        if len == 0.0 {
+            return false;
+        }
+        let (cs, sn) = (hx / len, hy / len);
         let along = |f: [f64; 2]| cs * f[0] + sn * f[1];
         let across = |f: [f64; 2]| -sn * f[0] + cs * f[1];
         let m = c.crossing_margin;

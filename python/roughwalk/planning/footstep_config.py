@@ -1,0 +1,356 @@
+"""Settings of the footstep planner, scaled to the robot (Zucker 2011, §4).
+
+Every length is a multiple of the robot's hip-to-hip length L (front to
+hind hip joints along x; 0.202 m for LittleDog, 0.60 m for ANYmal C), so
+one set of numbers serves every registered robot. The LittleDog values
+are given in brackets.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from roughwalk.errors import ConfigError
+
+if TYPE_CHECKING:
+    from roughwalk.robots.robot import Robot
+
+__all__ = ["CertificateConfig", "FootstepConfig", "WALKING_ORDERS", "hip_to_hip_length"]
+
+# Canonical leg indices: 0 LF, 1 RF, 2 LH, 3 RH.
+LEG_INDEX = {"LF": 0, "RF": 1, "LH": 2, "RH": 3}
+# The statically stable crawl: each hind leg is followed by the front leg on its side.
+WALKING_ORDERS = {"crawl": ("LH", "LF", "RH", "RF")}
+
+
+def hip_to_hip_length(robot: Robot) -> float:
+    """Distance L [m] along x between the front and hind hip (HAA) joints."""
+    hips = robot.hip_positions
+    return float(0.5 * (hips[0, 0] + hips[1, 0]) - 0.5 * (hips[2, 0] + hips[3, 0]))
+
+
+def _check(name: str, value: float, low: float = 0.0, strict: bool = False) -> None:
+    ok = math.isfinite(value) and (value > low if strict else value >= low)
+    if not ok:
+        relation = ">" if strict else ">="
+        raise ConfigError(f"footstep.{name} must be a finite number {relation} {low}, got {value}")
+
+
+@dataclass(frozen=True)
+class CertificateConfig:
+    """The pose-certificate search (Zucker 2011, §4.4) and the pose penalties of §4.3.
+
+    Attributes
+    ----------
+    max_iterations:
+        Most correction rounds (the paper's 25). More rescues harder stances
+        at the price of slower rejections.
+    alpha_reach, beta_reach:
+        Translation [1] and rotation [rad/m²] step sizes of the reachability
+        correction (§3.2). Larger converges in fewer rounds but may overshoot.
+    reach_overshoot:
+        How far past the closest reachable point the correction aims [m]
+        (0.01 L [2 mm]), so that it lands inside the workspace.
+    alpha_obstacle, beta_obstacle:
+        Step sizes of the obstacle-avoidance correction (§3.4) [1], [rad/m²].
+    com_margin:
+        The CoM must lie this far inside the next step's support triangle [m]
+        (0.05 L [1 cm]). Larger is more robust to CoM errors but prunes more
+        stances.
+    max_step, max_turn:
+        Longest trunk translation [m] (0.1 L) and rotation [rad] per round,
+        all corrections together.
+    max_drift:
+        The search gives up once the trunk is this far from its guessed
+        position [m] (0.5 L): near a singular leg the obstacle step's
+        Jacobians blow up and would fling the trunk away.
+    clearance:
+        Least body clearance, feet excluded [m] (0.02 L [4 mm]). The SDF's
+        interpolation error bound is added on top of it, so the true
+        clearance is at least this.
+    clearance_overshoot:
+        How far past ``clearance`` the obstacle correction aims [m].
+    preferred_clearance:
+        Clearance below which the pose cost rises [m] (0.05 L [1 cm]).
+    clearance_penalty:
+        Pose cost at ``clearance``, falling linearly to 0 at ``preferred_clearance``.
+    singularity_margin:
+        Legs whose normalised Jacobian volume |det J|/Π|J_k| (1 far from
+        singular, 0 singular) is below this pay a penalty.
+    singularity_penalty:
+        Pose cost per leg at a singularity, falling linearly to 0 at the margin.
+    max_tilt:
+        Largest roll and pitch of the starting trunk pose guessed from the feet [rad].
+
+    """
+
+    max_iterations: int = 25
+    alpha_reach: float = 0.7
+    beta_reach: float = 50.0
+    reach_overshoot: float = 0.002
+    alpha_obstacle: float = 0.7
+    beta_obstacle: float = 30.0
+    com_margin: float = 0.01
+    max_step: float = 0.02
+    max_turn: float = 0.15
+    max_drift: float = 0.1
+    clearance: float = 0.004
+    clearance_overshoot: float = 0.002
+    preferred_clearance: float = 0.01
+    clearance_penalty: float = 0.5
+    singularity_margin: float = 0.25
+    singularity_penalty: float = 0.5
+    max_tilt: float = 0.5
+
+    def __post_init__(self) -> None:
+        if self.max_iterations < 1:
+            raise ConfigError(
+                f"footstep.certificate.max_iterations must be >= 1, got {self.max_iterations}"
+            )
+        for f in dataclasses.fields(self):
+            if f.name != "max_iterations":
+                _check(f"certificate.{f.name}", float(getattr(self, f.name)))
+        for name in ("max_step", "max_turn", "max_drift"):
+            _check(f"certificate.{name}", float(getattr(self, name)), strict=True)
+        if self.preferred_clearance < self.clearance:
+            raise ConfigError(
+                f"footstep.certificate.preferred_clearance ({self.preferred_clearance}) must be "
+                f">= clearance ({self.clearance})"
+            )
+        if self.singularity_margin > 1:
+            raise ConfigError(
+                "footstep.certificate.singularity_margin is a fraction in [0, 1], "
+                f"got {self.singularity_margin}"
+            )
+
+
+@dataclass(frozen=True)
+class FootstepConfig:
+    """Everything the footstep planner needs to know; build it with :meth:`for_robot`.
+
+    Attributes
+    ----------
+    resolution:
+        Foothold lattice spacing [m] (L/40 [5 mm], the paper's grid). Finer
+        finds better footholds but multiplies the states.
+    actions:
+        Footstep displacements (dx, dy, dθ) [m, m, rad] of the moving leg in
+        the heading frame, added to its nominal place around the feet's
+        centroid (12–25 in the paper). Default: dx ∈ {−0.1, 0, 0.1, 0.2, 0.3}·L
+        × dy ∈ {−0.1, 0, 0.1}·L, and turns of ±0.15 rad with dx ∈ {0, 0.15 L}:
+        19 actions.
+    walking_order:
+        Leg names in stepping order (the crawl LH, LF, RH, RF).
+    local_search_radius:
+        Radius of the search for a cheaper foothold around each action's
+        target [m] (L/20 [1 cm]; footnote 1 of the paper); 0 turns it off.
+    local_search_penalty:
+        Cost per ``local_search_radius`` of distance from the target, so that
+        among equal footholds the action's own wins.
+    max_foot_travel:
+        Longest horizontal move of a foot in one step [m] (0.6 L). It also
+        bounds the centroid's progress per step (a quarter of it), which makes
+        the Euclidean heuristic admissible.
+    min_foot_separation:
+        Least horizontal distance between two feet [m] (0.2 L).
+    crossing_margin:
+        Left feet stay this far left of right feet and front feet this far
+        ahead of hind feet [m] (0.05 L).
+    step_cost:
+        Cost of every step on top of terrain and pose costs (1: a flat
+        foothold costs as much as taking a step). Larger prefers fewer steps.
+    incircle_preferred, incircle_min:
+        Support triangles with a smaller incircle radius [m] pay a pose cost
+        (0.18 L), or are refused (0.08 L) (§4.3).
+    incircle_penalty:
+        Pose cost at ``incircle_min``, falling linearly to 0 at ``incircle_preferred``.
+    certificate:
+        The pose-certificate search (:class:`CertificateConfig`).
+    goal_radius:
+        The goal is reached when the feet's centroid is this close to it [m] (L/4).
+    heuristic:
+        ``"dubins"`` (the paper's, informed but not admissible) or
+        ``"euclidean"`` (admissible: the plan's bound ε′ is then guaranteed).
+    turning_radius:
+        Turning radius of the Dubins car [m] (L).
+    dubins_cost_per_metre:
+        Cost per metre of the Dubins heuristic; 0 takes the cost of a flat
+        step over the centroid's progress per step at the longest forward action.
+    epsilon0, epsilon_decrement:
+        ARA*'s initial heuristic inflation ε₀ and its decrement per iteration.
+        A larger ε₀ finds a first plan sooner, a worse one.
+    max_tree_edges:
+        Search-tree edges kept for pictures (0 keeps none).
+    cache_capacity:
+        Certificate outcomes cached across plans and re-plans (about 40 bytes each).
+    sdf_resolution:
+        Voxel size of the terrain's signed distance field [m] (L/40 [5 mm]).
+        Its interpolation error bound (0.87 × this) is added to the clearance.
+    sdf_z_margin:
+        Free space the SDF covers above the terrain [m] (1.4 × the nominal
+        trunk height); the body above it is checked by a slower exact fall-back.
+    cost_heading:
+        Heading [rad] of the terrain cost map for a cost learned on oriented
+        features (the map is computed once per terrain); ignored otherwise.
+
+    """
+
+    resolution: float = 0.005
+    actions: tuple[tuple[float, float, float], ...] = ()
+    walking_order: tuple[str, str, str, str] = WALKING_ORDERS["crawl"]
+    local_search_radius: float = 0.01
+    local_search_penalty: float = 0.1
+    max_foot_travel: float = 0.12
+    min_foot_separation: float = 0.04
+    crossing_margin: float = 0.01
+    step_cost: float = 1.0
+    incircle_preferred: float = 0.036
+    incircle_min: float = 0.016
+    incircle_penalty: float = 1.0
+    certificate: CertificateConfig = field(default_factory=CertificateConfig)
+    goal_radius: float = 0.05
+    heuristic: str = "dubins"
+    turning_radius: float = 0.2
+    dubins_cost_per_metre: float = 0.0
+    epsilon0: float = 3.0
+    epsilon_decrement: float = 0.5
+    max_tree_edges: int = 20_000
+    cache_capacity: int = 4_000_000
+    sdf_resolution: float = 0.005
+    sdf_z_margin: float = 0.25
+    cost_heading: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check("resolution", self.resolution, strict=True)
+        if not self.actions:
+            raise ConfigError(
+                "footstep.actions must hold at least one (dx, dy, dtheta); "
+                "use FootstepConfig.for_robot(robot) for the defaults"
+            )
+        try:
+            acts = np.asarray(self.actions, dtype=float)
+        except (TypeError, ValueError):
+            raise ConfigError(
+                f"footstep.actions must be (dx, dy, dtheta) triples, got {self.actions!r}"
+            ) from None
+        if acts.ndim != 2 or acts.shape[1] != 3 or not np.all(np.isfinite(acts)):
+            raise ConfigError(
+                f"footstep.actions must be finite (dx, dy, dtheta) triples, got shape {acts.shape}"
+            )
+        object.__setattr__(self, "actions", tuple(tuple(float(v) for v in a) for a in acts))
+        order = tuple(self.walking_order)
+        if sorted(order) != sorted(LEG_INDEX):
+            raise ConfigError(
+                f"footstep.walking_order must name each of LF, RF, LH, RH once, got {order}"
+            )
+        object.__setattr__(self, "walking_order", order)
+        for name in (
+            "local_search_radius",
+            "local_search_penalty",
+            "min_foot_separation",
+            "incircle_min",
+            "incircle_penalty",
+            "turning_radius",
+            "dubins_cost_per_metre",
+        ):
+            _check(name, float(getattr(self, name)))
+        for name in (
+            "max_foot_travel",
+            "step_cost",
+            "goal_radius",
+            "epsilon_decrement",
+            "sdf_resolution",
+        ):
+            _check(name, float(getattr(self, name)), strict=True)
+        _check("sdf_z_margin", self.sdf_z_margin)
+        if not math.isfinite(self.crossing_margin) or not math.isfinite(self.cost_heading):
+            raise ConfigError("footstep.crossing_margin and footstep.cost_heading must be finite")
+        if self.incircle_preferred < self.incircle_min:
+            raise ConfigError(
+                f"footstep.incircle_preferred ({self.incircle_preferred}) must be >= "
+                f"incircle_min ({self.incircle_min})"
+            )
+        if self.heuristic not in ("dubins", "euclidean"):
+            raise ConfigError(
+                f"unknown footstep.heuristic '{self.heuristic}'; known: dubins, euclidean"
+            )
+        if not (math.isfinite(self.epsilon0) and self.epsilon0 >= 1):
+            raise ConfigError(f"footstep.epsilon0 must be >= 1, got {self.epsilon0}")
+        if self.max_tree_edges < 0 or self.cache_capacity < 0:
+            raise ConfigError("footstep.max_tree_edges and cache_capacity must be >= 0")
+
+    @classmethod
+    def for_robot(cls, robot: Robot, **overrides: Any) -> FootstepConfig:
+        """The defaults scaled to ``robot``'s hip-to-hip length, then ``overrides``.
+
+        ``overrides`` are field names (``heuristic="euclidean"``) or, for the
+        certificate, ``certificate=CertificateConfig(...)`` or dotted-free
+        ``certificate_<field>=...`` keys (``certificate_clearance=0.006``).
+        """
+        length = hip_to_hip_length(robot)
+        if not (math.isfinite(length) and length > 0):
+            raise ConfigError(
+                f"robot '{robot.name}' has front and hind hips {length} m apart; "
+                "the footstep planner needs front hips ahead of hind hips"
+            )
+        half = 0.5 * length
+        cert_over = {
+            k.removeprefix("certificate_"): v
+            for k, v in overrides.items()
+            if k.startswith("certificate_")
+        }
+        certificate = CertificateConfig(
+            beta_reach=0.5 / half**2,
+            reach_overshoot=0.01 * length,
+            beta_obstacle=0.3 / half**2,
+            com_margin=0.05 * length,
+            max_step=0.1 * length,
+            max_drift=0.5 * length,
+            clearance=0.02 * length,
+            clearance_overshoot=0.01 * length,
+            preferred_clearance=0.05 * length,
+            **cert_over,
+        )
+        actions = [
+            (dx * length, dy * length, 0.0)
+            for dx in (-0.1, 0.0, 0.1, 0.2, 0.3)
+            for dy in (-0.1, 0.0, 0.1)
+        ]
+        actions += [(dx * length, 0.0, dth) for dth in (-0.15, 0.15) for dx in (0.0, 0.15)]
+        defaults: dict[str, Any] = {
+            "resolution": length / 40,
+            "actions": tuple(actions),
+            "local_search_radius": length / 20,
+            "max_foot_travel": 0.6 * length,
+            "min_foot_separation": 0.2 * length,
+            "crossing_margin": 0.05 * length,
+            "incircle_preferred": 0.18 * length,
+            "incircle_min": 0.08 * length,
+            "certificate": certificate,
+            "goal_radius": 0.25 * length,
+            "turning_radius": length,
+            "sdf_resolution": length / 40,
+            "sdf_z_margin": 1.4 * robot.nominal_stance.base_height,
+        }
+        defaults.update({k: v for k, v in overrides.items() if not k.startswith("certificate_")})
+        names = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(defaults) - names)
+        if unknown:
+            raise ConfigError(
+                f"unknown footstep config field(s) {unknown}; known: {', '.join(sorted(names))}"
+            )
+        return cls(**defaults)
+
+    def to_core(self) -> dict[str, Any]:
+        """The dict the Rust planner reads: leg names become canonical indices."""
+        d = dataclasses.asdict(self)
+        d["walking_order"] = [LEG_INDEX[name] for name in self.walking_order]
+        d["actions"] = [tuple(a) for a in self.actions]
+        for key in ("sdf_resolution", "sdf_z_margin", "cost_heading"):
+            d.pop(key)
+        return d
