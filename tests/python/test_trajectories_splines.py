@@ -83,8 +83,12 @@ def test_swing_spline_is_smooth_and_rests_at_both_ends(
     p_plus, v_plus, _ = spline.evaluate(inner + h)
     p_minus, v_minus, _ = spline.evaluate(inner - h)
     np.testing.assert_allclose((p_plus - p_minus) / (2 * h), vel[1:-1], atol=1e-6)
+    # (A knot at a sample: the jerk jumps there, so allow h·jerk.)
+    jerk = np.abs(np.diff(acc, axis=0)).max() / (t[1] - t[0])
     np.testing.assert_allclose(
-        (v_plus - v_minus) / (2 * h), acc[1:-1], atol=1e-4 * max(1.0, np.abs(acc).max())
+        (v_plus - v_minus) / (2 * h),
+        acc[1:-1],
+        atol=1e-4 * max(1.0, np.abs(acc).max()) + 2 * h * jerk,
     )
     # ... and continuous across the waypoints (C²): jumps no bigger than the jerk allows.
     jerk = np.abs(np.diff(acc, axis=0)).max() / (t[1] - t[0])

@@ -25,20 +25,29 @@ from roughwalk.trajectories.whole_body import WholeBody
 
 __all__ = ["BodyPass", "clearance_ok", "velocity_ok", "velocity_excess"]
 
+# The ZMP here comes from CHOMP's samples; the check at the control rate
+# differentiates a spline through them and lands up to about a millimetre
+# elsewhere, so CHOMP stops only with that much to spare [m].
+_ZMP_GUARD = 0.001
+
 
 def clearance_ok(
     clearance: NDArray[np.float64],
     active: NDArray[np.bool_],
+    points: NDArray[np.float64],
     is_foot: NDArray[np.bool_],
+    footholds: NDArray[np.float64],
     validity: ValidityConfig,
     contact_clearance: float = 0.0,
 ) -> bool:
-    """Whether active points (T, U) keep the clearance the validity settings ask for.
+    """Whether active points (T, U) at ``points`` (T, U, 3) keep the clearance asked for.
 
-    ``contact_clearance`` [m] is the lifted foot's clearance on its footholds.
+    ``footholds`` (K, 3) are the lifted foot's start and target and
+    ``contact_clearance`` [m] its clearance on them
+    (:meth:`ValidityConfig.required_clearance`).
     """
-    need = np.where(is_foot, validity.foot_floor(contact_clearance), validity.min_clearance)
-    return bool(np.all((clearance >= need[None, :]) | ~active))
+    need = validity.required_clearance(points, is_foot, footholds, contact_clearance)
+    return bool(np.all((clearance >= need) | ~active))
 
 
 def velocity_excess(q: NDArray[np.float64], dt: float, limit: NDArray[np.float64]) -> float:
@@ -121,6 +130,7 @@ class BodyPass:
         foot_down = pts.is_foot[None, :] & state.support[:, leg]
         self.active = ~foot_down
         self.held_q = state.q.copy()
+        self.footholds = np.array([state.step.start, state.step.target])
         self.hips = wb.robot.hip_positions
 
     def configure(
@@ -203,11 +213,13 @@ class BodyPass:
             and clearance_ok(
                 obs.clearance,
                 self.active,
+                points,
                 self.wb.points.is_foot,
+                self.footholds,
                 self.validity,
                 s.contact_clearance,
             )
-            and bool(np.all(margins >= -self.validity.zmp_tolerance))
+            and bool(np.all(margins >= _ZMP_GUARD - self.validity.zmp_tolerance))
         )
         return Evaluation(
             value=obs.value + reach_value + sup_value,
@@ -242,7 +254,15 @@ class BodyPass:
         keep = np.arange(4) != leg
         return (
             bool(np.all(reached))
-            and clearance_ok(d, active, self.wb.points.is_foot, self.validity, s.contact_clearance)
-            and bool(np.all(margins >= -self.validity.zmp_tolerance))
+            and clearance_ok(
+                d,
+                active,
+                points,
+                self.wb.points.is_foot,
+                self.footholds,
+                self.validity,
+                s.contact_clearance,
+            )
+            and bool(np.all(margins >= _ZMP_GUARD - self.validity.zmp_tolerance))
             and velocity_ok(q[:, keep], s.dt, self.wb.velocity_limit[keep])
         )

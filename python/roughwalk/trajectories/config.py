@@ -10,6 +10,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+from numpy.typing import NDArray
+
 from roughwalk.errors import ConfigError
 
 __all__ = [
@@ -315,11 +318,36 @@ class ValidityConfig:
         contact).
     zmp_tolerance:
         The ZMP may leave the support polygon by at most this much [m].
+    contact_zone:
+        A lifted foot within this distance [m] of its start or target may
+        touch the ground (down to ``foot_tolerance``); farther away it must
+        keep ``min_clearance`` like the rest of the body, so that grazing an
+        obstacle is not mistaken for landing.
     """
 
     min_clearance: float = 0.0
     foot_tolerance: float = 0.001
     zmp_tolerance: float = 0.0
+    contact_zone: float = 0.02
+
+    def required_clearance(
+        self,
+        points: NDArray[np.float64],
+        is_foot: NDArray[np.bool_],
+        footholds: NDArray[np.float64],
+        contact_clearance: float = 0.0,
+    ) -> NDArray[np.float64]:
+        """The clearance [m] each point (T, U, 3) must keep.
+
+        ``min_clearance``, or the foot floor for a foot point within
+        ``contact_zone`` of a foothold (K, 3).
+        """
+        near = np.zeros(points.shape[:2], dtype=bool)
+        if np.any(is_foot):
+            feet = points[:, is_foot]
+            dist = np.linalg.norm(feet[:, :, None, :] - footholds[None, None], axis=-1).min(axis=-1)
+            near[:, is_foot] = dist < self.contact_zone
+        return np.where(near, self.foot_floor(contact_clearance), self.min_clearance)
 
     def foot_floor(self, contact_clearance: float = 0.0) -> float:
         """The least clearance [m] a lifted foot may have.
@@ -333,7 +361,7 @@ class ValidityConfig:
     def __post_init__(self) -> None:
         if not math.isfinite(self.min_clearance):
             raise ConfigError(f"validity.min_clearance must be finite, got {self.min_clearance}")
-        _check_nonnegative(self, ("foot_tolerance", "zmp_tolerance"), "validity")
+        _check_nonnegative(self, ("foot_tolerance", "zmp_tolerance", "contact_zone"), "validity")
 
 
 @dataclass(frozen=True)

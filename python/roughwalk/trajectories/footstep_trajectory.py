@@ -128,14 +128,26 @@ def resample_footstep(
     n = max(int(round((t1 - t0) * config.control_rate_hz)), 1)
     time = np.linspace(t0, t1, n + 1)
     dt = (t1 - t0) / n
-    # Clamped at both ends to the rates the step starts and ends with, so that
-    # consecutive footsteps join with continuous trunk velocity.
-    body_spline = make_interp_spline(
-        state.times,
-        state.body,
-        k=3,
-        bc_type=([(1, state.end_rates[0])], [(1, state.end_rates[1])]),
-    )
+    # A quintic clamped at both ends to the rates and accelerations the step
+    # starts and ends with, so consecutive footsteps join with continuous trunk
+    # velocity and acceleration (and the ZMP computed from it stays put there).
+    if state.n_samples >= 6:
+        body_spline = make_interp_spline(
+            state.times,
+            state.body,
+            k=5,
+            bc_type=(
+                [(1, state.end_rates[0]), (2, state.end_accelerations[0])],
+                [(1, state.end_rates[1]), (2, state.end_accelerations[1])],
+            ),
+        )
+    else:
+        body_spline = make_interp_spline(
+            state.times,
+            state.body,
+            k=3,
+            bc_type=([(1, state.end_rates[0])], [(1, state.end_rates[1])]),
+        )
     body = body_spline(time)
     body_vel = body_spline.derivative(1)(time)
     body_acc = body_spline.derivative(2)(time)
@@ -186,7 +198,13 @@ def resample_footstep(
 
     clearance_all = capsule_clearances(wb, sdf, q, body[:, :3], rot)
     per_sample, foot_clearance, per_link, collision_free = clearance_summary(
-        wb, clearance_all, support, config.validity, state.contact_clearance
+        wb,
+        clearance_all,
+        support,
+        config.validity,
+        feet,
+        np.array([state.step.start, state.step.target]),
+        state.contact_clearance,
     )
     speed_limit = wb.velocity_limit.reshape(12)
     qd_c = qd.reshape(-1, 12)

@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from roughwalk.trajectories.body_keyframes import BodyKeyframe
 from roughwalk.trajectories.body_spline import BodySpline
 from roughwalk.trajectories.config import SwingConfig
-from roughwalk.trajectories.euler import rpy_to_matrix
+from roughwalk.trajectories.euler import matrix_to_rpy, rpy_to_matrix, skew
 from roughwalk.trajectories.step_sequence import StepSpec
 from roughwalk.trajectories.support_polygon import convex_polygon
 from roughwalk.trajectories.swing_spline import SwingSpline
@@ -94,6 +94,8 @@ class FootstepState:
     end_rates: NDArray[np.float64] = field(default_factory=lambda: np.zeros((2, 6)))
     """Trunk rates (x, y, z, roll, pitch, yaw per second) at the first and last sample:
     the CoM's from the preview controller, the rest from the keyframe spline."""
+    end_accelerations: NDArray[np.float64] = field(default_factory=lambda: np.zeros((2, 6)))
+    """The same for the second derivatives."""
 
     @property
     def n_samples(self) -> int:
@@ -113,6 +115,43 @@ class FootstepState:
         q, reached = wb.inverse_kinematics(feet_b)
         self.q = np.where(mask[..., None], q, self.q)
         self.reached = np.where(mask, reached, self.reached)
+
+
+def _reach_by_height_and_tilt(
+    wb: WholeBody, feet: NDArray[np.float64], pose: NDArray[np.float64], iterations: int = 30
+) -> NDArray[np.float64] | None:
+    """Trunk (x, y, z, roll, pitch, yaw) with z and tilt changed until ``feet`` (4, 3) are reached.
+
+    The §3.2 virtual force, Δz = α·Σe_z and ω = β·Σ(f′ − x) × e, without its
+    horizontal part. Returns None when every foot is already reached.
+    """
+    x = pose[:3].copy()
+    rot = rpy_to_matrix(pose[3:])
+    changed = False
+    for _ in range(iterations):
+        q, reached = wb.inverse_kinematics(((feet - x) @ rot)[None])
+        if reached.all():
+            break
+        reach = x + wb.foot_positions(q)[0] @ rot.T
+        e = feet - reach
+        x[2] += 0.5 * float(e[:, 2].sum())
+        omega = 2.0 * np.cross(reach - x, e).sum(axis=0)
+        rot = axis_angle(omega) @ rot
+        changed = True
+    if not changed:
+        return None
+    out = np.concatenate([x, matrix_to_rpy(rot)])
+    out[5] = _unwrap_to(float(out[5]), float(pose[5]))
+    return out
+
+
+def axis_angle(omega: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Rotation matrix of the rotation vector ``omega`` [rad]."""
+    angle = float(np.linalg.norm(omega))
+    if angle < 1e-12:
+        return np.eye(3)
+    k = skew(omega / angle)
+    return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
 
 
 def _unwrap_to(angle: float, reference: float) -> float:
@@ -195,11 +234,24 @@ def build_initial_trajectory(
     if n_settle:
         knots.append(times[-1])
         values.append(values[-1])
-    spline = BodySpline(np.array(knots), np.array(values))
+    run = controller.run(reference, n, start.com_state, preview=preview_samples)
+    values_arr = np.array(values)
+    spline = BodySpline(np.array(knots), values_arr)
+    pose = spline.value(times)
+    # The ZMP keeps the trunk from the landing pose's x–y at touchdown; where
+    # the landing foot is then out of reach, lower and tilt the trunk there
+    # instead (Zucker 2011, §3.2, with the horizontal push left out: vertical
+    # motion and rotation barely move the ZMP, §5.2 footnote 3).
+    touch_xy = run.com[touchdown] - pose[touchdown, 4:6]
+    fixed = _reach_by_height_and_tilt(
+        wb, step.stance_after, np.concatenate([touch_xy, pose[touchdown, :4]])
+    )
+    if fixed is not None:
+        values_arr[2:, :4] = fixed[2:]
+        spline = BodySpline(np.array(knots), values_arr)
     pose, pose_rate, pose_acc = spline.evaluate(times)
     offset = pose[:, 4:7]
 
-    run = controller.run(reference, n, start.com_state, preview=preview_samples)
     body = np.empty((n + 1, 6))
     body[:, :2] = run.com - offset[:, :2]
     body[:, 2] = pose[:, 0]
@@ -265,9 +317,13 @@ def build_initial_trajectory(
         polygon_index=polygon_index,
     )
     rates = np.empty((2, 6))
+    accelerations = np.empty((2, 6))
     for row, k in ((0, 0), (1, n)):
         rates[row, :2] = run.com_velocity[k] - pose_rate[k, 4:6]
         rates[row, 2:] = pose_rate[k, :4]
+        accelerations[row, :2] = run.com_acceleration[k] - pose_acc[k, 4:6]
+        accelerations[row, 2:] = pose_acc[k, :4]
     state.end_rates = rates
+    state.end_accelerations = accelerations
     state.solve_legs(wb, np.ones((n + 1, 4), dtype=bool))
     return state

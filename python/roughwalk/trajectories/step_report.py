@@ -117,6 +117,8 @@ def clearance_summary(
     clearance: NDArray[np.float64],
     support: NDArray[np.bool_],
     validity: ValidityConfig,
+    feet: NDArray[np.float64],
+    footholds: NDArray[np.float64],
     contact_clearance: float = 0.0,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, float], bool]:
     """Clearances of a footstep's samples from its primitives' clearances (n, P) [m].
@@ -124,17 +126,19 @@ def clearance_summary(
     Returns the least clearance per sample over the primitives that are not
     feet (n,), the lifted foot's (n,; NaN while all feet are down), the least
     per link, and whether the footstep is collision-free: supporting feet
-    are skipped, a lifted foot may dip ``foot_tolerance`` into the field
-    (below its footholds' ``contact_clearance`` [m]), every other primitive
-    must keep ``min_clearance``.
+    are skipped; a lifted foot (centres ``feet`` (n, 4, 3)) near its
+    ``footholds`` (K, 3) may dip ``foot_tolerance`` into the field (below
+    their ``contact_clearance`` [m]); everything else must keep
+    ``min_clearance``.
     """
     cm = wb.collision
     leg = np.maximum(cm.leg, 0)
     checked = ~(cm.is_foot[None, :] & support[:, leg])
     masked = np.where(checked, clearance, np.inf)
+    feet_at = feet
     body = masked[:, ~cm.is_foot].min(axis=1)
-    feet = masked[:, cm.is_foot].min(axis=1)
-    feet = np.where(np.isinf(feet), np.nan, feet)
+    foot_min = masked[:, cm.is_foot].min(axis=1)
+    foot_min = np.where(np.isinf(foot_min), np.nan, foot_min)
     names = primitive_names(wb)
     per_link: dict[str, float] = {}
     for k, name in enumerate(names):
@@ -142,6 +146,9 @@ def clearance_summary(
         if np.all(np.isinf(col)):
             continue
         per_link[name] = min(per_link.get(name, np.inf), float(col.min()))
-    need = np.where(cm.is_foot, validity.foot_floor(contact_clearance), validity.min_clearance)
-    free = bool(np.all(masked >= need[None, :]))
-    return body, feet, per_link, free
+    centres = np.zeros(clearance.shape + (3,))
+    foot_rows = np.flatnonzero(cm.is_foot)
+    centres[:, foot_rows] = feet_at[:, cm.leg[foot_rows]]
+    need = validity.required_clearance(centres, cm.is_foot, footholds, contact_clearance)
+    free = bool(np.all(masked >= need))
+    return body, foot_min, per_link, free

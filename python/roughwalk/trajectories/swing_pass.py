@@ -131,7 +131,9 @@ class SwingPass:
             and clearance_ok(
                 obs.clearance,
                 self.active,
+                points,
                 self.is_foot,
+                np.array([self.state.step.start, self.state.step.target]),
                 self.validity,
                 self.state.contact_clearance,
             )

@@ -66,10 +66,10 @@ class ZmpReference:
         ``anchors`` (S + 1, 2) [m]: the ZMP at rest before the first step,
         then one per step (inside that step's support triangle); with a
         settling phase on the last step, one more: where the ZMP comes to rest.
-        Step k shifts from anchor k − 1 to anchor k, then moves through its
-        swing to ``exits[k]`` (S, 2) (default: holds anchor k); the next
-        shift starts from there. A settling phase moves to the final anchor in
-        its first half and holds it.
+        Step k shifts from anchor k − 1 to anchor k, then moves in the first
+        three quarters of its swing to ``exits[k]`` (S, 2) (default: holds
+        anchor k) and holds it; the next shift starts from there. A settling
+        phase moves to the final anchor in its first half and holds it.
         """
         a = np.asarray(anchors, dtype=float)
         settle = any(t.settle_s > 0 for t in timings)
@@ -91,6 +91,10 @@ class ZmpReference:
             t += timing.shift_s
             times.append(t)
             points.append(a[k])
+            # Reach the exit three quarters into the swing and hold it, so the
+            # ZMP has settled when the foot lands.
+            times.append(t + 0.75 * timing.swing_s)
+            points.append(out[k - 1])
             t += timing.swing_s
             times.append(t)
             points.append(out[k - 1])
