@@ -308,7 +308,7 @@ mod tests {
         let mut h = Vec::new();
         for ix in 0..9 {
             for iy in 0..9 {
-                h.push(((ix * 7 + iy * 3) % 5) as f64 * 0.01);
+                h.push(f64::from((ix * 7 + iy * 3) % 5) * 0.01);
             }
         }
         let hf = HeightField::new(0.0, 0.0, 0.01, 0.01, 9, 9, h, None).unwrap();
