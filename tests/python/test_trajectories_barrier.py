@@ -169,7 +169,7 @@ def test_crawl_output_is_consistent(robot, crawl_result: FootstepTrajectories) -
     t = data["time"]
     assert np.all(np.diff(t) > 0)
     # Starts and ends at rest.
-    assert np.linalg.norm(data["base_vel"][0]) < 1e-9
+    assert np.linalg.norm(data["base_vel"][0]) < 1e-4
     assert np.linalg.norm(data["base_vel"][-1]) < 5e-3
     # Supporting feet stay where the plan put them (IK at every control sample).
     for s in res.steps:

@@ -236,6 +236,7 @@ class BodyPass:
         s.body = body
         s.q = q
         s.reached = reached
+        s.update_com_offset(self.wb)
         airborne = ~s.support
         if np.any(airborne):
             feet_w = body[:, None, :3] + np.einsum("tij,tlj->tli", rot, self.wb.foot_positions(q))

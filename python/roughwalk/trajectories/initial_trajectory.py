@@ -107,6 +107,16 @@ class FootstepState:
         """(T, 3, 3) trunk orientations."""
         return rpy_to_matrix(self.body[:, 3:])
 
+    def update_com_offset(self, wb: WholeBody) -> None:
+        """Recompute the CoM's offset from the trunk (T, 3) [m, world] from the joint angles.
+
+        With its second derivative: the swing leg's motion moves the CoM too.
+        """
+        off = np.einsum("tij,tj->ti", self.rotation, wb.center_of_mass(self.q))
+        self.com_offset = off
+        rate = np.gradient(off, self.dt, axis=0, edge_order=2)
+        self.com_offset_acceleration = np.gradient(rate, self.dt, axis=0, edge_order=2)
+
     def solve_legs(self, wb: WholeBody, legs: NDArray[np.bool_] | None = None) -> None:
         """Re-solve IK for the feet marked in ``legs`` (T, 4) (default: the supporting ones)."""
         mask = self.support if legs is None else legs
@@ -316,14 +326,23 @@ def build_initial_trajectory(
         polygons=polygons,
         polygon_index=polygon_index,
     )
+    everything = np.ones((n + 1, 4), dtype=bool)
+    state.solve_legs(wb, everything)
+    # The trunk carries the CoM the preview planned, offset by where the legs
+    # (the swing leg above all) actually put it: a fixed point, found in a few rounds.
+    for _ in range(3):
+        state.update_com_offset(wb)
+        state.body[:, :2] = run.com - state.com_offset[:, :2]
+        state.solve_legs(wb, everything)
+    state.update_com_offset(wb)
+    offset_rate = np.gradient(state.com_offset, dt, axis=0, edge_order=2)
     rates = np.empty((2, 6))
     accelerations = np.empty((2, 6))
     for row, k in ((0, 0), (1, n)):
-        rates[row, :2] = run.com_velocity[k] - pose_rate[k, 4:6]
+        rates[row, :2] = run.com_velocity[k] - offset_rate[k, :2]
         rates[row, 2:] = pose_rate[k, :4]
-        accelerations[row, :2] = run.com_acceleration[k] - pose_acc[k, 4:6]
+        accelerations[row, :2] = run.com_acceleration[k] - state.com_offset_acceleration[k, :2]
         accelerations[row, 2:] = pose_acc[k, :4]
     state.end_rates = rates
     state.end_accelerations = accelerations
-    state.solve_legs(wb, np.ones((n + 1, 4), dtype=bool))
     return state

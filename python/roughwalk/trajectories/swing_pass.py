@@ -151,6 +151,7 @@ class SwingPass:
         s = self.state
         q = self._window_q(xi)
         s.q[self.window] = q
+        s.update_com_offset(self.wb)
         foot_b = self.wb.foot_positions(q)[:, self.leg]
         inner = slice(s.lift_off + 1, s.touchdown)
         s.feet[inner, self.leg] = self.body[1:-1, :3] + np.einsum(
