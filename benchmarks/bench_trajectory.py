@@ -19,6 +19,7 @@ Run: ``python3 benchmarks/bench_trajectory.py [--quick] [--steps N]``.
 from __future__ import annotations
 
 import argparse
+import os
 import time
 from pathlib import Path
 from typing import Any
@@ -210,9 +211,14 @@ def main() -> int:
             "within_target": float(np.mean(every <= TARGET_MS)),
         }
     fig8 = figure8_step(robot)
+    load = os.getloadavg()
     print(
         f"Figure 8 barrier step (generated terrain): {fig8['median_ms']:.1f} ms median over "
         f"{len(fig8['ms'])} runs, {fig8['iterations']} CHOMP iterations, valid: {fig8['valid']}"
+    )
+    print(
+        f"load average {load[0]:.1f} on {os.cpu_count()} CPUs: the times scale with it "
+        "(other processes share the cores)"
     )
     write_json(
         RESULTS,
@@ -223,6 +229,7 @@ def main() -> int:
             target_ms=TARGET_MS,
             settings=out,
             figure8_step=fig8,
+            load_average=list(load),
         ),
     )
     print(f"wrote {RESULTS}")

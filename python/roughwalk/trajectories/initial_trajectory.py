@@ -138,12 +138,17 @@ def _reach_by_height_and_tilt(
     x = pose[:3].copy()
     rot = rpy_to_matrix(pose[3:])
     changed = False
+    hips = wb.robot.hip_positions
     for _ in range(iterations):
-        q, reached = wb.inverse_kinematics(((feet - x) @ rot)[None])
+        # Aim 2 mm past each foot, away from its hip, to land with some slack.
+        feet_b = (feet - x) @ rot
+        out = feet_b - hips
+        aim_b = feet_b + 0.002 * out / np.linalg.norm(out, axis=1, keepdims=True)
+        q, reached = wb.inverse_kinematics(aim_b[None])
         if reached.all():
             break
         reach = x + wb.foot_positions(q)[0] @ rot.T
-        e = feet - reach
+        e = x + aim_b @ rot.T - reach
         x[2] += 0.5 * float(e[:, 2].sum())
         omega = 2.0 * np.cross(reach - x, e).sum(axis=0)
         rot = axis_angle(omega) @ rot
@@ -328,12 +333,25 @@ def build_initial_trajectory(
     )
     everything = np.ones((n + 1, 4), dtype=bool)
     state.solve_legs(wb, everything)
-    # The trunk carries the CoM the preview planned, offset by where the legs
-    # (the swing leg above all) actually put it: a fixed point, found in a few rounds.
     for _ in range(3):
-        state.update_com_offset(wb)
-        state.body[:, :2] = run.com - state.com_offset[:, :2]
+        # The trunk carries the CoM the preview planned, offset by where the legs
+        # (the swing leg above all) actually put it: a fixed point, in a few rounds.
+        for _ in range(3):
+            state.update_com_offset(wb)
+            state.body[:, :2] = run.com - state.com_offset[:, :2]
+            state.solve_legs(wb, everything)
+        # That moves the trunk at touchdown; check the landing foot's reach again.
+        fixed = _reach_by_height_and_tilt(wb, step.stance_after, state.body[touchdown])
+        if fixed is None:
+            break
+        values_arr[2:, :4] = fixed[2:]
+        spline = BodySpline(np.array(knots), values_arr)
+        pose, pose_rate, pose_acc = spline.evaluate(times)
+        state.body[:, 2:] = pose[:, :4]
         state.solve_legs(wb, everything)
+    # The first sample is the previous step's last, exactly.
+    state.body[0] = np.concatenate([start.base_pos, start.rpy])
+    state.solve_legs(wb, everything)
     state.update_com_offset(wb)
     offset_rate = np.gradient(state.com_offset, dt, axis=0, edge_order=2)
     rates = np.empty((2, 6))
