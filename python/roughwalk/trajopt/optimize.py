@@ -106,9 +106,12 @@ class TrajoptProblem:
         """
         nlp = self.formulation
         resolved = initializer.adjust_task(resolve(task, self.body, self.terrain))
+        lam_x = lam_g = None
         if warm_start is None:
             x0 = initializer.guess(nlp, resolved)
         else:
+            if isinstance(warm_start, TrajoptResult):
+                lam_x, lam_g = warm_start.lam_x, warm_start.lam_g
             x0 = np.asarray(warm_start.x if isinstance(warm_start, TrajoptResult) else warm_start)
             if x0 is None or x0.size != nlp.n_variables:
                 raise InvalidArgumentError(
@@ -118,7 +121,13 @@ class TrajoptProblem:
         build = self.build_time_s if self._build_pending else 0.0
         self._build_pending = False
         outcome = self.solver.solve(
-            resolved.vector(), x0, max_iter=max_iter, time_limit_s=time_limit_s, callback=callback
+            resolved.vector(),
+            x0,
+            max_iter=max_iter,
+            time_limit_s=time_limit_s,
+            callback=callback,
+            lam_x0=lam_x if lam_x is not None and lam_x.size == x0.size else None,
+            lam_g0=lam_g if lam_g is not None and lam_g.size == nlp.n_constraints else None,
         )
         return self._result(task, outcome, build, extra_time_s)
 
@@ -164,6 +173,8 @@ class TrajoptProblem:
             return_status=outcome.return_status,
             history=outcome.history,
             x=outcome.x,
+            lam_x=outcome.lam_x,
+            lam_g=outcome.lam_g,
             terrain=self.terrain.name,
         )
 

@@ -124,6 +124,8 @@ class TrajoptResult:
         Per iteration: objective, violation and elapsed time.
     x:
         The solution vector (for warm starts).
+    lam_x, lam_g:
+        Its bound and constraint multipliers (for warm starts).
 
     """
 
@@ -147,6 +149,8 @@ class TrajoptResult:
     return_status: str = ""
     history: list[dict[str, float]] = field(default_factory=list)
     x: NDArray[np.float64] | None = None
+    lam_x: NDArray[np.float64] | None = None
+    lam_g: NDArray[np.float64] | None = None
     robot: str | None = None
     terrain: str | None = None
 
@@ -247,7 +251,12 @@ class TrajoptResult:
         """
         out: dict[str, Any] = self.summary()
         out["task"] = (
-            {"start": list(self.task.start), "goal": list(self.task.goal)} if self.task else None
+            {
+                "start": [_finite(v) for v in self.task.start],
+                "goal": [_finite(v) for v in self.task.goal],
+            }
+            if self.task
+            else None
         )
         out["config"] = self.config
         out["body"] = self.body.to_dict() if self.body else None

@@ -1,0 +1,321 @@
+"""Solves: Melon et al.'s three tasks, dynamics against a forward simulation, bad tasks, guesses."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from roughwalk.errors import InvalidArgumentError
+from roughwalk.terrain import load_terrain
+from roughwalk.trajopt import (
+    TrajoptResult,
+    TrajoptStatus,
+    optimize_motion,
+    towr_config,
+)
+from roughwalk.trajopt.terrain_model import TerrainModel
+from roughwalk.trajopt.variables import euler_to_rotation
+
+GRAVITY = np.array([0.0, 0.0, -9.80665])
+
+# Melon 2020, §V: flat ground 1.5 m in 3.5 s trotting (14 steps); a single
+# pallet (edge at x = 1 m) from 0.5–1.5 m before its edge to (1.6, 0) on top,
+# and a double pallet to (1.8, 0) on its upper level, walking 16 steps in 5.5 s.
+MELON_TASKS = {
+    "flat": (
+        "flat",
+        ((0.0, 0.0, 0.0), (1.5, 0.0, 0.0)),
+        {"gait": "trot", "steps": 14, "duration": 3.5},
+    ),
+    "single_pallet": (
+        "single_pallet",
+        ((-0.3, 0.15, 0.2), (1.6, 0.0, 0.0)),
+        {"gait": "walk", "steps": 16, "duration": 5.5},
+    ),
+    "double_pallet": (
+        "double_pallet",
+        ((0.0, 0.0, 0.0), (1.8, 0.0, 0.0)),
+        {"gait": "walk", "steps": 16, "duration": 5.5},
+    ),
+}
+
+
+@pytest.fixture(scope="module")
+def melon() -> dict[str, TrajoptResult]:
+    """Each of Melon et al.'s tasks solved once, with TOWR's ANYmal (the robot they used)."""
+    out = {}
+    for name, (terrain, task, options) in MELON_TASKS.items():
+        out[name] = optimize_motion(None, terrain, task, body_model="towr_anymal", **options)
+    return out
+
+
+@pytest.mark.parametrize("name", list(MELON_TASKS))
+def test_melon_tasks_solve(melon: dict[str, TrajoptResult], name: str) -> None:
+    result = melon[name]
+    assert result.status in (TrajoptStatus.EXACT, TrajoptStatus.APPROXIMATE), result.message
+    assert result.solved
+    assert result.max_violation < 1e-3
+    assert 0 < result.objective < 20
+    # Start and goal are where the task says, at rest.
+    start, goal = MELON_TASKS[name][1]
+    s = result.sample(50.0)
+    np.testing.assert_allclose(s["com_position"][0, :2], start[:2], atol=1e-6)
+    np.testing.assert_allclose(s["com_position"][-1, :2], goal[:2], atol=1e-4)
+    np.testing.assert_allclose(s["base_euler"][-1, 2], goal[2], atol=1e-4)
+    np.testing.assert_allclose(s["base_linear_velocity"][[0, -1]], 0.0, atol=1e-4)
+    # Forces vanish in swing, never exceed f_max, and carry the weight on average.
+    assert result.body is not None
+    forces = s["forces"]
+    assert np.abs(forces[~s["contact"]]).max(initial=0.0) < 1e-9
+    assert result.max_force_n <= result.body.force_limit + 1e-3
+    mean_total = forces[:, :, 2].sum(axis=1).mean()
+    assert mean_total == pytest.approx(result.body.weight, rel=0.1)
+
+
+def test_feet_stand_on_the_terrain_and_step_over_it(melon: dict[str, TrajoptResult]) -> None:
+    for name, result in melon.items():
+        terrain = TerrainModel(load_terrain(MELON_TASKS[name][0]))
+        s = result.sample(100.0)
+        feet = s["feet_position"]
+        for foot in range(4):
+            h = terrain.height(feet[:, foot, :2])
+            stance = s["contact"][:, foot]
+            np.testing.assert_allclose(feet[stance, foot, 2], h[stance], atol=2e-3, err_msg=name)
+            # Each swing's apex (its middle node) clears both footholds by the
+            # swing clearance (Melon's swing-height constraint).
+            assert result.schedule is not None
+            bounds = result.schedule.phase_times(foot)
+            clearance = result.config["swing_clearance"]
+            for k in range(1, len(bounds) - 2):
+                if result.schedule.is_stance(foot, k):
+                    continue
+                z = result.sample(
+                    times=[bounds[k], 0.5 * (bounds[k] + bounds[k + 1]), bounds[k + 1]]
+                )
+                before, apex, after = z["feet_position"][:, foot, 2]
+                assert apex >= max(before, after) + clearance - 1e-4, (name, foot, k)
+    on_top = melon["double_pallet"].sample(10.0)["com_position"][-1, 2]
+    assert on_top > 0.31 + 0.3  # the base ends standing on the upper pallet
+
+
+def test_step_edge_cost_keeps_footholds_off_the_edge() -> None:
+    # Melon's Gaussian step-edge cost: the same climb without it puts footholds
+    # nearer the pallet's edge than with it.
+    task = ((0.0, 0.0, 0.0), (1.6, 0.0, 0.0))
+    options = {"body_model": "towr_anymal", "gait": "walk", "steps": 16, "duration": 5.5}
+    terrain = TerrainModel(load_terrain("single_pallet"))
+
+    def edge_cost(result: TrajoptResult) -> float:
+        s = result.sample(20.0)
+        held = s["feet_position"][s["contact"]]
+        return float(terrain.edge_cost(held[:, :2]).sum())
+
+    with_cost = optimize_motion(None, "single_pallet", task, **options)
+    without = optimize_motion(None, "single_pallet", task, costs__step_edge=0.0, **options)
+    assert with_cost.solved and without.solved
+    assert "step_edge" in with_cost.costs and "step_edge" not in without.costs
+    assert edge_cost(with_cost) < 0.5 * edge_cost(without)
+
+
+def test_dynamics_match_a_forward_simulation(melon: dict[str, TrajoptResult]) -> None:
+    # Integrate m c̈ = Σf + m g and d/dt(I_w ω) = Σ (p − c) × f with the optimised
+    # forces and footholds (scipy, written here independently of the NLP),
+    # from the plan's state at every dynamics sample over one sample interval
+    # (0.1 s: TOWR enforces the dynamics only at these samples). The plan must
+    # match; forces 10 % too strong must not.
+    result = melon["single_pallet"]
+    assert result.body is not None
+    mass, inertia = result.body.mass, result.body.inertia_matrix
+
+    def skew(w: np.ndarray) -> np.ndarray:
+        return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
+
+    def state(t: float) -> np.ndarray:
+        s = result.sample(times=[t])
+        rot = euler_to_rotation(s["base_euler"][0])
+        return np.concatenate(
+            [
+                s["com_position"][0],
+                s["base_linear_velocity"][0],
+                rot.ravel(),
+                s["base_angular_velocity"][0],
+            ]
+        )
+
+    def errors(scale: float) -> tuple[float, float]:
+        splines = result.splines
+        assert splines is not None
+
+        def rhs(t: float, y: np.ndarray) -> np.ndarray:
+            c, v, rot, w = y[:3], y[3:6], y[6:15].reshape(3, 3), y[15:]
+            f = scale * np.array([s.evaluate([t])[0][0] for s in splines.forces])
+            p = np.array([s.evaluate([t])[0][0] for s in splines.feet])
+            i_world = rot @ inertia @ rot.T
+            w_dot = np.linalg.solve(i_world, np.cross(p - c, f).sum(0) - np.cross(w, i_world @ w))
+            return np.concatenate([v, f.sum(0) / mass + GRAVITY, (skew(w) @ rot).ravel(), w_dot])
+
+        pos, ang = [], []
+        for t0 in np.arange(0.0, result.duration - 0.05, 0.1):
+            sol = solve_ivp(rhs, (t0, t0 + 0.1), state(t0), rtol=1e-8, atol=1e-10, max_step=0.01)
+            ref = state(t0 + 0.1)
+            pos.append(np.abs(sol.y[:3, -1] - ref[:3]).max())
+            ang.append(np.abs(sol.y[6:15, -1] - ref[6:15]).max())
+        return float(np.median(pos)), float(np.median(ang))
+
+    pos, ang = errors(1.0)
+    assert pos < 3e-3  # [m] after 0.1 s
+    assert ang < 0.01  # rotation matrix entries after 0.1 s
+    wrong_pos, _ = errors(1.2)
+    assert wrong_pos > 3 * pos
+
+
+def test_result_json_and_npz(melon: dict[str, TrajoptResult], tmp_path: Path) -> None:
+    result = melon["flat"]
+    data = json.loads(json.dumps(result.to_dict(rate_hz=20.0)))
+    for key in (
+        "status",
+        "solved",
+        "iterations",
+        "solve_time_s",
+        "objective",
+        "max_violation",
+        "max_force_n",
+        "n_variables",
+        "nodes",
+        "trajectory",
+        "phase_durations",
+    ):
+        assert key in data
+    assert data["solved"] is True
+    assert len(data["trajectory"]["t"]) == 71  # 3.5 s at 20 Hz, both ends
+    assert np.asarray(data["trajectory"]["feet_position"]).shape == (71, 4, 3)
+    out = result.to_dict(rate_hz=50.0, npz=tmp_path / "motion.npz")
+    assert "trajectory" not in out
+    arrays = np.load(out["trajectory_npz"])
+    np.testing.assert_allclose(arrays["t"][-1], 3.5)
+    np.testing.assert_allclose(np.linalg.norm(arrays["base_quat"], axis=1), 1.0)
+
+
+def test_towr_feasibility_problem_reuses_its_build_and_warm_starts() -> None:
+    config = towr_config()
+    task = ((0.0, 0.0, 0.0), (1.5, 0.0, 0.0))
+    first = optimize_motion(None, "flat", task, config=config, gait="walk", steps=16, duration=3.4)
+    assert first.solved and first.objective == 0.0 and first.n_variables == 848
+    assert first.build_time_s > 0
+    second = optimize_motion(
+        None,
+        "flat",
+        ((0.0, 0.0, 0.0), (1.2, 0.2, 0.3)),
+        config=config,
+        gait="walk",
+        steps=16,
+        duration=3.4,
+    )
+    assert second.solved and second.build_time_s == 0.0
+    again = optimize_motion(
+        None, "flat", task, config=config, gait="walk", steps=16, duration=3.4, warm_start=first
+    )
+    assert again.solved and again.iterations <= 2
+
+
+def test_optimised_durations_stay_in_bounds_and_sum_to_the_duration() -> None:
+    result = optimize_motion(
+        None,
+        "flat",
+        ((0.0, 0.0, 0.0), (0.8, 0.0, 0.0)),
+        config=towr_config(optimize_durations=True),
+        gait="walk",
+        steps=8,
+        duration=3.0,
+    )
+    assert result.solved, result.message
+    assert result.schedule is not None
+    for durations in result.schedule.durations:
+        assert sum(durations) == pytest.approx(3.0)
+        assert min(durations[:-1]) >= 0.2 - 1e-6 and max(durations[:-1]) <= 1.0 + 1e-6
+
+
+SMALL = {"config": towr_config(), "gait": "walk", "steps": 4, "duration": 2.0}
+
+
+@pytest.mark.parametrize(
+    ("terrain", "task", "options", "match"),
+    [
+        ("flat", ((float("nan"), 0.0, 0.0), (1.0, 0.0, 0.0)), {}, "not finite"),
+        ("flat", ((0.0, 0.0, 0.0), (1.0, float("inf"), 0.0)), {}, "not finite"),
+        ("towr_block:height=1.0", ((0.0, 0.0, 0.0), (0.7, 0.0, 0.0)), {}, "inside an obstacle"),
+        ("flat", ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)), {"duration": 0.2}, "too short"),
+        (
+            "flat",
+            ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)),
+            {"duration": 0.5, "config": towr_config(optimize_durations=True)},
+            "too short",
+        ),
+    ],
+)
+def test_bad_tasks_get_a_clear_status(terrain: str, task: tuple, options: dict, match: str) -> None:
+    result = optimize_motion(None, terrain, task, **{**SMALL, **options})
+    assert result.status is TrajoptStatus.INVALID_INPUT
+    assert not result.solved
+    assert match in result.message
+    assert json.dumps(result.to_dict(), allow_nan=False)
+
+
+def test_limits_and_callback_stop_with_their_status() -> None:
+    task = ((0.0, 0.0, 0.0), (0.6, 0.0, 0.0))
+    limited = optimize_motion(None, "flat", task, max_iter=2, **SMALL)
+    assert limited.status is TrajoptStatus.ITERATION_LIMIT and limited.iterations == 2
+    assert limited.sample(10.0)["t"].size == 21  # the last iterate can still be looked at
+    seen: list[int] = []
+    cancelled = optimize_motion(
+        None, "flat", task, callback=lambda i: seen.append(i.iteration) or i.iteration >= 1, **SMALL
+    )
+    assert cancelled.status is TrajoptStatus.CANCELLED and seen == [0, 1]
+    timed = optimize_motion(None, "flat", task, time_limit_s=1e-9, **SMALL)
+    assert timed.status is TrajoptStatus.TIMEOUT
+    # A far goal in a short time cannot be reached: IPOPT says so, no exception.
+    hopeless = optimize_motion(
+        None, "flat", ((0.0, 0.0, 0.0), (8.0, 0.0, 0.0)), max_iter=60, **SMALL
+    )
+    assert not hopeless.solved and hopeless.max_violation > 1e-3
+    with pytest.raises(InvalidArgumentError, match="walk gait cannot make 5 steps"):
+        optimize_motion(None, "flat", task, **{**SMALL, "steps": 5})
+
+
+def test_footsteps_guess_from_a_plan(tmp_path: Path) -> None:
+    # A hand-made plan in `roughwalk plan`'s format: start stance, then a crawl,
+    # each leg 0.15 m forward.
+    start = {"LF": (0.34, 0.19), "RF": (0.34, -0.19), "LH": (-0.34, 0.19), "RH": (-0.34, -0.19)}
+    steps = [{"leg": leg, "x": x, "y": y, "z": 0.0} for leg, (x, y) in start.items()]
+    for leg in ("RH", "RF", "LH", "LF"):
+        x, y = start[leg]
+        steps.append({"leg": leg, "x": x + 0.15, "y": y, "z": 0.0})
+    plan = tmp_path / "plan.json"
+    plan.write_text(json.dumps({"schema": "footstep_plan", "footsteps": steps}))
+    result = optimize_motion(
+        None,
+        "flat",
+        ((0.0, 0.0, 0.0), (0.15, 0.0, 0.0)),
+        config=towr_config(),
+        init=f"footsteps:{plan}",
+        duration=2.4,
+    )
+    assert result.solved, result.message
+    assert result.schedule is not None and result.schedule.name == "footsteps"
+    assert result.schedule.steps == 4
+    # One foot at a time: never fewer than three in stance.
+    assert result.sample(50.0)["contact"].sum(axis=1).min() == 3
+    with pytest.raises(InvalidArgumentError, match="initial stance"):
+        plan.write_text(json.dumps({"footsteps": steps[1:]}))
+        optimize_motion(
+            None,
+            "flat",
+            ((0.0, 0.0, 0.0), (0.15, 0.0, 0.0)),
+            config=towr_config(),
+            init=f"footsteps:{plan}",
+            duration=2.4,
+        )
