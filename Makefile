@@ -16,6 +16,15 @@ install:
 	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) \
 	  || echo "note: could not install chromium; the labelling app's browser test will skip"; \
 	else echo "note: chromium is not installed (needs root and apt-get); the labelling app's browser test will skip"; fi; }
+	@# Videos of simulated runs: headless OpenGL (Mesa's EGL, OSMesa as fallback) and the ffmpeg that
+	@# the imageio-ffmpeg wheel carries (without it videos are GIFs).
+	@$(PY) -c "import imageio_ffmpeg" 2>/dev/null || $(PIP) install --quiet 'imageio-ffmpeg>=0.4' \
+	  || echo "note: could not install imageio-ffmpeg; run videos will be GIFs"
+	@if ! ldconfig -p 2>/dev/null | grep -q 'libEGL_mesa\|libOSMesa'; then \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libegl1 libegl-mesa0 libgl1 libosmesa6 >/dev/null) \
+	    || echo "note: could not install EGL/OSMesa; run videos will be skipped"; \
+	  else echo "note: no headless OpenGL (EGL/OSMesa) and no root to install it; run videos will be skipped"; fi; fi
 
 demo: install
 	roughwalk demo --out-dir demo-output

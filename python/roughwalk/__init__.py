@@ -15,6 +15,7 @@ from roughwalk.errors import (
 )
 from roughwalk.planning.footstep_planner import plan_footsteps
 from roughwalk.robots import Robot, load_robot
+from roughwalk.sim.run import run
 from roughwalk.terrain import Terrain, load_terrain
 from roughwalk.trajopt import optimize_motion
 from roughwalk.trajectories.api import footstep_trajectories
@@ -31,6 +32,7 @@ __all__ = [
     "load_terrain",
     "Robot",
     "load_robot",
+    "run",
     "plan_footsteps",
     "optimize_motion",
     "footstep_trajectories",

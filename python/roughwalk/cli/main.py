@@ -20,6 +20,8 @@ COMMAND_MODULES = [
     "roughwalk.cli.bench_cmd",
     "roughwalk.cli.cost_cmd",
     "roughwalk.cli.trajectory_cmd",
+    "roughwalk.cli.run_cmd",
+    "roughwalk.cli.replay_cmd",
 ]
 
 

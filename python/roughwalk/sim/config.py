@@ -241,9 +241,9 @@ class ReflexConfig:
 
     enabled: bool = True
     body_position_m: float = 0.04
-    body_orientation_rad: float = 0.25
+    body_orientation_rad: float = 0.15
     foot_position_m: float = 0.035
-    foot_force_n: float = 2.0
+    foot_force_n: float = 6.0
     foot_force_fraction: float = 0.05
     persist_s: float = 0.03
     settle_s: float = 0.3

@@ -266,4 +266,7 @@ def default_source(robot: Robot, terrain: Terrain, **options: Any) -> FootstepSo
 
     if not hasattr(_core, "FootstepPlanner"):
         return CrawlSource(robot, terrain)
-    return PlannerSource(robot, terrain, **options)
+    try:
+        return PlannerSource(robot, terrain, **options)
+    except ImportError:
+        return CrawlSource(robot, terrain)

@@ -170,6 +170,13 @@ class World:
             foot.condim = contact.condim
             foot.solref = [contact.timeconst, contact.dampratio]
             foot.solimp = list(contact.solimp)
+        sky = spec.add_texture()
+        sky.name = "sky"
+        sky.type = mujoco.mjtTexture.mjTEXTURE_SKYBOX
+        sky.builtin = mujoco.mjtBuiltin.mjBUILTIN_GRADIENT
+        sky.width = sky.height = 256
+        sky.rgb1 = [0.55, 0.7, 0.85]
+        sky.rgb2 = [0.95, 0.97, 1.0]
         light = spec.worldbody.add_light()
         light.pos = [0.0, 0.0, 3.0]
         light.dir = [0.2, 0.3, -1.0]

@@ -1,0 +1,163 @@
+"""End-to-end runs in MuJoCo: plan, optimise, walk; reflexes, falls, logs, video, CLI."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import roughwalk
+from roughwalk import _core
+from roughwalk.sim import CrawlSource, Push, RunLog, RunResult, run
+from roughwalk.sim.footstep_source import FootstepSource, PlannerSource
+
+HAVE_PLANNER = hasattr(_core, "FootstepPlanner")
+
+
+@pytest.fixture(scope="module")
+def littledog() -> roughwalk.Robot:
+    return roughwalk.load_robot("littledog")
+
+
+def source(robot: roughwalk.Robot, terrain: roughwalk.Terrain) -> FootstepSource:
+    """The anytime planner in its deterministic mode (an expansion budget), else the crawl."""
+    if HAVE_PLANNER:
+        return PlannerSource(robot, terrain, expansions=2000)
+    return CrawlSource(robot, terrain)
+
+
+def walk(robot, terrain, goal=(0.75, 0.0), **kwargs) -> RunResult:
+    overrides = {"executor.compute_time_scale": 0.0, **kwargs.pop("overrides", {})}
+    return run(
+        robot,
+        terrain,
+        (0.25, 0.0, 0.0),
+        goal,
+        planner=source(robot, terrain),
+        **kwargs,
+        **overrides,
+    )
+
+
+def assert_walked_to_goal(result: RunResult) -> None:
+    o = result.outcome
+    assert o.success, o.reason
+    assert not o.fell and o.reason == "reached the goal"
+    assert o.distance_m == pytest.approx(0.5, abs=0.02)
+    log = result.log
+    feet = np.asarray(log["feet"], dtype=float)
+    centroid = feet.mean(axis=1)[:, :2]
+    # The measured feet, not the plan, ended at the goal ...
+    assert np.linalg.norm(centroid[-1] - [0.75, 0.0]) <= 0.06 * 1.5
+    # ... and the trunk never came near the terrain or tipped.
+    assert o.max_roll_rad < 0.3 and o.max_pitch_rad < 0.3
+    assert 0 < o.time_s < 120 and o.speed_cm_s == pytest.approx(100 * o.distance_m / o.time_s)
+    # Torque limits held throughout (the servos' force range is always in force).
+    limit = roughwalk.load_robot(result.robot).joint_torque_limit
+    forces = np.abs(np.asarray(log["actuator_force"], dtype=float))
+    assert np.all(forces <= limit * (1 + 1e-6))
+
+
+def test_littledog_walks_half_a_metre_on_flat_ground(littledog) -> None:
+    result = walk(littledog, roughwalk.load_terrain("flat"))
+    assert_walked_to_goal(result)
+    assert result.outcome.reflexes == 0
+    # Tracking on flat ground is tight.
+    log = result.log
+    walking = np.asarray(log["mode"]) == 0
+    err = np.linalg.norm(log["base_pos"] - log["base_pos_desired"], axis=1)[walking]
+    assert np.nanmax(err) < 0.01
+
+
+def test_a_push_beyond_the_threshold_triggers_a_reflex_and_a_replan(littledog) -> None:
+    terrain = roughwalk.load_terrain("flat")
+    result = walk(littledog, terrain, disturbances=[Push(impulse_ns=1.0, at_s=2.0)])
+    o = result.outcome
+    assert o.reflexes >= 1 and o.replans >= 1
+    events = [e["kind"] for e in result.log.events]
+    first_reflex = events.index("reflex")
+    assert events.index("push") < first_reflex < events.index("replan")
+    assert "recovery" in events[first_reflex:]
+    assert_walked_to_goal(result)
+    # Without reflexes the same push is not noticed: no re-plan.
+    blind = walk(
+        littledog,
+        terrain,
+        disturbances=[Push(impulse_ns=1.0, at_s=2.0)],
+        overrides={"reflex.enabled": False},
+    )
+    assert blind.outcome.reflexes == 0 and blind.outcome.replans == 0
+
+
+def test_a_fall_is_a_failure_with_its_reason(littledog) -> None:
+    terrain = roughwalk.load_terrain("flat")
+    result = walk(
+        littledog,
+        terrain,
+        disturbances=[Push(impulse_ns=3.0, at_s=1.0)],
+        overrides={"reflex.enabled": False},
+    )
+    o = result.outcome
+    assert not o.success and o.fell
+    assert o.reason.startswith("fell: ")
+    assert any(word in o.reason for word in ("rolled", "pitched", "trunk touched"))
+    assert o.speed_cm_s == 0.0
+    assert result.to_dict()["success"] is False
+    assert [e["kind"] for e in result.log.events][-2:] == ["fall", "end"]
+
+
+def test_run_log_round_trips_and_replays_to_a_video(littledog, tmp_path: Path) -> None:
+    from roughwalk.sim.video import VideoUnavailable, gl_backend, render_run
+
+    terrain = roughwalk.load_terrain("flat")
+    result = walk(littledog, terrain, goal=(0.35, 0.0))
+    paths = result.save(tmp_path / "out")
+    loaded = RunLog.load(paths["log"])
+    assert loaded.meta["robot"] == "littledog" and loaded.meta["terrain"] == "flat"
+    np.testing.assert_array_equal(loaded["time"], result.log["time"])
+    np.testing.assert_allclose(loaded["qpos"], result.log["qpos"])
+    assert loaded.events == json.loads(json.dumps(result.log.events))
+    doc = json.loads(paths["result"].read_text())
+    for key in ("success", "reason", "distance_m", "time_s", "speed_cm_s", "reflexes", "replans"):
+        assert key in doc
+    if gl_backend() is None:
+        pytest.skip(
+            "no headless OpenGL (EGL or OSMesa): install libegl1/libegl-mesa0 or libosmesa6"
+        )
+    try:
+        video = render_run(loaded, tmp_path / "replay.mp4", width=160, height=120, fps=5.0)
+    except VideoUnavailable as e:  # pragma: no cover - depends on the machine
+        pytest.skip(str(e))
+    assert video.is_file() and video.stat().st_size > 1000
+
+
+def test_cli_run_writes_json_report_and_replays(tmp_path: Path) -> None:
+    from roughwalk.cli.main import main
+
+    out = tmp_path / "run"
+    code = main(
+        [
+            "run", "--terrain", "flat", "--start", "0.25,0,0", "--goal", "0.35,0",
+            "--planner", "crawl", "--out-dir", str(out), "--json", str(out / "out.json"),
+            "--no-video", "--set", "executor.compute_time_scale=0",
+        ]
+    )  # fmt: skip
+    assert code == 0
+    doc = json.loads((out / "out.json").read_text())
+    assert doc["schema"] == "run" and doc["success"] is True
+    assert doc["speed_cm_s"] > 0 and doc["reflexes"] == 0 and doc["replans"] == 0
+    page = (out / "index.html").read_text()
+    assert "path.png" in page and "tracking.png" in page and "Reached the goal" in page
+    assert main(["run", "--terrain", "flat", "--start", "0,0", "--goal", "x,1"]) == 1
+    from roughwalk.sim.video import gl_backend
+
+    if gl_backend() is None:
+        pytest.skip(
+            "no headless OpenGL (EGL or OSMesa): install libegl1/libegl-mesa0 or libosmesa6"
+        )
+    gif = out / "r.gif"
+    assert main(["replay", str(out / "run.json"), "--video", str(gif),
+                 "--size", "96x64", "--fps", "2"]) == 0  # fmt: skip
+    assert gif.is_file() and gif.stat().st_size > 500
