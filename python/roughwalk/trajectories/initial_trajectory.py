@@ -338,8 +338,12 @@ def build_initial_trajectory(
         # (the swing leg above all) actually put it: a fixed point, in a few rounds.
         for _ in range(3):
             state.update_com_offset(wb)
-            state.body[:, :2] = run.com - state.com_offset[:, :2]
+            xy = run.com - state.com_offset[:, :2]
+            moved = float(np.abs(xy - state.body[:, :2]).max())
+            state.body[:, :2] = xy
             state.solve_legs(wb, everything)
+            if moved < 1e-4:
+                break
         # That moves the trunk at touchdown; check the landing foot's reach again.
         fixed = _reach_by_height_and_tilt(wb, step.stance_after, state.body[touchdown])
         if fixed is None:
