@@ -123,6 +123,8 @@ def plan_fields(plan: Any) -> dict[str, Any]:
         "footsteps": list(footsteps),
         "certificates": list(_get(plan, "certificates", None) or []),
         "initial_pose": _get(plan, "initial_pose", None),
+        "status": _get(plan, "status", None),
+        "reason": _get(plan, "reason", None),
     }
 
 
@@ -249,9 +251,11 @@ class StepSequence:
         fields = plan_fields(plan)
         entries = fields["footsteps"]
         if len(entries) < 5:
+            status = fields["status"]
+            why = f" (the planner's status: {status}: {fields['reason']})" if status else ""
             raise PlanningError(
                 f"a footstep plan needs the 4 feet of its initial stance and at least one step; "
-                f"got {len(entries)} footsteps"
+                f"got {len(entries)} footsteps{why}"
             )
         contacts = np.full((4, 3), np.nan)
         for i, entry in enumerate(entries[:4]):
