@@ -165,8 +165,8 @@ def stance_problems(
 ) -> list[str]:
     """Say why the nominal stance at ``pose`` cannot be stood in.
 
-    Unknown ground, or ground more uneven than the legs reach (a pose inside
-    an obstacle). Beyond the grid the terrain continues its border, as
+    Unknown ground, or ground too steep or more uneven than the legs reach
+    (a pose inside an obstacle). Beyond the grid the terrain continues its border, as
     :class:`~roughwalk.terrain.Terrain` does.
     """
     x, y, yaw = pose
@@ -182,11 +182,18 @@ def stance_problems(
     known = terrain.terrain.is_known(feet[inside, :2]) if inside.any() else np.ones(0, bool)
     if not np.all(known):
         out.append(f"{what} ({x:g}, {y:g}): the feet would stand on unknown terrain")
-    spread = float(np.ptp(feet[:, 2]))
-    reach = 2.0 * body.max_deviation[2]
-    if spread > reach:
+    # The body may tilt with the ground, so only what no plane through the
+    # footholds explains must fit in the legs' vertical reach, and the plane
+    # itself must be walkable (at most 45°).
+    design = np.column_stack([np.ones(4), body.stance[:, :2]])
+    coeffs, *_ = np.linalg.lstsq(design, feet[:, 2], rcond=None)
+    uneven = float(np.abs(feet[:, 2] - design @ coeffs).max())
+    slope = float(np.hypot(coeffs[1], coeffs[2]))
+    reach = body.max_deviation[2]
+    if uneven > reach or slope > 1.0:
         out.append(
-            f"{what} ({x:g}, {y:g}) is inside an obstacle: the nominal footholds span "
-            f"{spread:.3f} m of height, more than the {reach:.3f} m the legs can reach"
+            f"{what} ({x:g}, {y:g}) is inside an obstacle: the nominal footholds lie "
+            f"{uneven:.3f} m off their best plane (the legs reach {reach:.3f} m) on ground "
+            f"sloping {np.degrees(np.arctan(slope)):.0f}° (at most 45°)"
         )
     return out
