@@ -304,18 +304,23 @@ class FootstepConfig:
             for k, v in overrides.items()
             if k.startswith("certificate_")
         }
-        certificate = CertificateConfig(
-            beta_reach=0.5 / half**2,
-            reach_overshoot=0.01 * length,
-            beta_obstacle=0.3 / half**2,
-            com_margin=0.05 * length,
-            max_step=0.1 * length,
-            max_drift=0.5 * length,
-            clearance=0.02 * length,
-            clearance_overshoot=0.01 * length,
-            preferred_clearance=0.05 * length,
-            **cert_over,
-        )
+        scaled: dict[str, Any] = {
+            "beta_reach": 0.5 / half**2,
+            "reach_overshoot": 0.01 * length,
+            "beta_obstacle": 0.3 / half**2,
+            "com_margin": 0.05 * length,
+            "max_step": 0.1 * length,
+            "max_drift": 0.5 * length,
+            "clearance": 0.02 * length,
+            "clearance_overshoot": 0.01 * length,
+            "preferred_clearance": 0.05 * length,
+        }
+        cert_names = {f.name for f in dataclasses.fields(CertificateConfig)}
+        unknown_cert = sorted(set(cert_over) - cert_names)
+        if unknown_cert:
+            known = ", ".join(sorted(cert_names))
+            raise ConfigError(f"unknown certificate field(s) {unknown_cert}; known: {known}")
+        certificate = CertificateConfig(**{**scaled, **cert_over})
         actions = [
             (dx * length, dy * length, 0.0)
             for dx in (-0.1, 0.0, 0.1, 0.2, 0.3)

@@ -250,6 +250,6 @@ class FootstepPlan:
             "certificate_failures": dict(self.certificate_failures),
             "robot": self.robot,
             "terrain": self.terrain,
-            "start": list(self.start),
-            "goal": list(self.goal),
+            "start": [_finite_or_none(v) for v in self.start],
+            "goal": [_finite_or_none(v) for v in self.goal],
         }

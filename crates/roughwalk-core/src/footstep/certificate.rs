@@ -333,6 +333,16 @@ impl CertificateSearch<'_> {
     ) -> Result<PoseCertificate, CertificateFailure> {
         let cfg = self.config;
         let legs = self.robot.legs();
+        // Hips are rigid: two feet farther apart than their hips' distance plus
+        // both reaches cannot be held by any trunk pose.
+        for i in 0..4 {
+            for j in i + 1..4 {
+                let (a, b) = (&self.reach[i], &self.reach[j]);
+                if norm(sub(feet[i], feet[j])) > norm(sub(a.hip, b.hip)) + a.max + b.max {
+                    return Err(CertificateFailure::Unreachable);
+                }
+            }
+        }
         let tri = support.map(|leg| [contacts[leg][0], contacts[leg][1]]);
         let required = cfg.clearance + self.sdf_error;
         let cutoff = required.max(cfg.preferred_clearance + self.sdf_error);
