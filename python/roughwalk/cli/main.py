@@ -16,6 +16,7 @@ COMMAND_MODULES = [
     "roughwalk.cli.sdf_cmd",
     "roughwalk.cli.robot_cmd",
     "roughwalk.cli.demo_cmd",
+    "roughwalk.cli.plan_cmd",
     "roughwalk.cli.optimize_cmd",
     "roughwalk.cli.bench_cmd",
     "roughwalk.cli.cost_cmd",
