@@ -153,3 +153,21 @@ def test_hermite_point_matches_its_definition() -> None:
     p1, dp1, _ = hermite_point(x0, v0, x1, v1, d, d)
     assert (p0, dp0) == pytest.approx((x0, v0))
     assert (p1, dp1) == pytest.approx((x1, v1))
+
+
+def test_initialisers_by_name_and_the_learned_plug_in_point() -> None:
+    from roughwalk.trajopt import initializer_names, make_initializer, register_initializer
+
+    assert {"heuristic", "footsteps"} <= set(initializer_names())
+    assert isinstance(make_initializer("heuristic"), HeuristicInitializer)
+    with pytest.raises(ConfigError, match="registered by roughwalk.learning"):
+        make_initializer("learned")
+    with pytest.raises(InvalidArgumentError, match="does not exist"):
+        make_initializer("footsteps:/no/such/plan.json")
+    register_initializer("learned", lambda argument: HeuristicInitializer(argument))
+    try:
+        assert isinstance(make_initializer("learned"), HeuristicInitializer)
+    finally:
+        from roughwalk.trajopt.initializers import registry
+
+        registry._REGISTRY.pop("learned")
