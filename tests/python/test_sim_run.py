@@ -71,6 +71,17 @@ def test_littledog_walks_half_a_metre_on_flat_ground(littledog) -> None:
     assert np.nanmax(err) < 0.01
 
 
+@pytest.mark.skipif(not HAVE_PLANNER, reason="the compiled core has no FootstepPlanner")
+def test_littledog_walks_half_a_metre_over_generated_rocks(littledog) -> None:
+    # A small course: LittleDog-board rocks up to 5 cm (the full 10.8 cm is the benchmark's).
+    terrain = roughwalk.load_terrain("large_rocks:seed=1,max_height=0.05")
+    result = walk(littledog, terrain)
+    assert_walked_to_goal(result)
+    # The feet really went over the rocks: some foothold was well above the floor.
+    feet = np.asarray(result.log["feet"], dtype=float)
+    assert feet[..., 2].max() > 0.025
+
+
 def test_a_push_beyond_the_threshold_triggers_a_reflex_and_a_replan(littledog) -> None:
     terrain = roughwalk.load_terrain("flat")
     result = walk(littledog, terrain, disturbances=[Push(impulse_ns=1.0, at_s=2.0)])

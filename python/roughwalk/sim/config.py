@@ -226,6 +226,10 @@ class ReflexConfig:
         indeterminate, so an unloaded foot is no error).
     foot_force_fraction:
         See ``foot_force_n``.
+    foot_force_tilt_rad:
+        A lost load counts only once the trunk's orientation error exceeds
+        this [rad]: a robot balanced on a diagonal with one foot unloaded is
+        not falling, one that tilts while a foot lets go is.
     persist_s:
         An error must last this long [s] to count, so impact transients do not.
     settle_s:
@@ -243,8 +247,9 @@ class ReflexConfig:
     body_position_m: float = 0.04
     body_orientation_rad: float = 0.15
     foot_position_m: float = 0.035
-    foot_force_n: float = 6.0
+    foot_force_n: float = 2.0
     foot_force_fraction: float = 0.05
+    foot_force_tilt_rad: float = 0.05
     persist_s: float = 0.03
     settle_s: float = 0.3
     lower_s: float = 0.5
@@ -264,7 +269,9 @@ class ReflexConfig:
             ),
             "reflex",
         )
-        _nonnegative(self, ("foot_force_fraction", "persist_s", "settle_s"), "reflex")
+        _nonnegative(
+            self, ("foot_force_fraction", "foot_force_tilt_rad", "persist_s", "settle_s"), "reflex"
+        )
         if not (isinstance(self.max_reflexes, int) and self.max_reflexes >= 0):
             raise ConfigError(
                 f"reflex.max_reflexes must be an integer ≥ 0, got {self.max_reflexes}"

@@ -127,6 +127,7 @@ class Executor:
         self.log = RunLog()
         self._plan: _Plan | None = None
         self._step_index = 0
+        self._leg_joints = np.asarray(robot.canonical_index).reshape(4, 3)
 
     # ---- planning -------------------------------------------------------------------
 
@@ -276,6 +277,8 @@ class Executor:
                     desired = self._start_recovery(measured, desired, now)
                     mode = "recovery"
             q_cmd = self.integrator.update(desired, measured)
+            if desired.kind == "recovery":
+                q_cmd = self._catch(q_cmd, desired, measured)
             command = self.controller.command(q_cmd, desired, measured)
             for disturbance in self.disturbances:
                 disturbance.apply(self.world, now, monitor.first_motion, log)
@@ -397,6 +400,22 @@ class Executor:
         state, _, _ = self.buffer.advance(now)
         assert state is not None
         return state
+
+    def _catch(
+        self, q_cmd: np.ndarray, desired: DesiredState, measured: MeasuredState
+    ) -> np.ndarray:
+        """Aim the feet the reflex puts down at their world footholds, from the measured trunk.
+
+        So they land where planned however the trunk is tipping.
+        """
+        lifted = ~desired.support
+        if not np.any(lifted):
+            return q_cmd
+        q, _ = self.robot.inverse_kinematics(desired.feet, measured.base_pos, measured.base_quat)
+        joints = self._leg_joints[lifted].ravel()
+        out = q_cmd.copy()
+        out[joints] = q[joints]
+        return out
 
     @property
     def terrain_for_recovery(self) -> Terrain:

@@ -184,6 +184,7 @@ def recovery_segment(
     lower_s: float,
     settle_s: float,
     ready_at: float,
+    press_m: float = 0.0,
 ) -> tuple[list[Segment], NDArray[np.float64]]:
     """The reflex's motion from ``measured``: feet down, trunk over them, hold.
 
@@ -197,6 +198,8 @@ def recovery_segment(
         Time [s] for the first two parts together (stretched if a joint needs it).
     settle_s:
         Hold time [s] at the end.
+    press_m:
+        How far [m] below the terrain surface the lowered feet aim.
 
     Returns the segments and the four footholds (4, 3) [m] the robot ends on.
     """
@@ -211,7 +214,9 @@ def recovery_segment(
         goal = np.asarray(planned_feet[leg], dtype=float).copy()
         if np.linalg.norm(goal[:2] - start_feet[leg, :2]) > 0.02:
             goal = start_feet[leg].copy()
-        goal[2] = float(terrain.height(goal[None, :2])[0]) + r
+        # "Firmly on the ground": aim a little into it, so the servo presses
+        # the foot down and the pressing legs stop the trunk tipping.
+        goal[2] = float(terrain.height(goal[None, :2])[0]) + r - press_m
         target[leg] = goal
     # Part 1, fast: the lifted feet down (with a 1.5 cm arch if they move
     # across), trunk still; the robot may be tipping towards them.

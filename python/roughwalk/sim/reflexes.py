@@ -81,17 +81,14 @@ class ReflexMonitor:
         # a landing a few millimetres off is not a slip.
         self._down_since = np.where(down, np.minimum(self._down_since, now), np.inf)
         settled = down & (now - self._down_since >= 2 * cfg.persist_s)
+        tilt = orientation_error(measured.base_quat, desired.base_quat)
         out: dict[str, tuple[float, float, str | None]] = {
             "body_position": (
                 float(np.linalg.norm(measured.base_pos - desired.base_pos)),
                 cfg.body_position_m,
                 None,
             ),
-            "body_orientation": (
-                orientation_error(measured.base_quat, desired.base_quat),
-                cfg.body_orientation_rad,
-                None,
-            ),
+            "body_orientation": (tilt, cfg.body_orientation_rad, None),
         }
         foot_error = np.where(settled, np.linalg.norm(measured.feet - desired.feet, axis=1), 0.0)
         worst = int(np.argmax(foot_error))
@@ -101,7 +98,8 @@ class ReflexMonitor:
         # foot a millimetre high carries nothing and the robot is still fine.
         # With three, a planned load the foot does not carry means tipping.
         determinate = bool(np.sum(down) == 3)
-        loaded = settled & (planned >= cfg.foot_force_n) & determinate
+        tipping = tilt > cfg.foot_force_tilt_rad
+        loaded = settled & (planned >= cfg.foot_force_n) & determinate & tipping
         shortfall = np.where(loaded, planned - measured.foot_forces[:, 2], 0.0)
         limit = np.where(loaded, (1.0 - cfg.foot_force_fraction) * planned, np.inf)
         ratio = shortfall / limit

@@ -1,0 +1,198 @@
+"""The Learning Locomotion metric in simulation: LittleDog success rate and speed per class.
+
+Zucker 2011, §1: "by the end of Phase III, LittleDog was required to traverse
+obstacles up to 10.8 cm height at speeds in excess of 7.2 cm/s". Each run
+plans (the anytime planner, ``--plan-time`` seconds before the clock starts),
+optimises each footstep while the previous one executes, and walks in MuJoCo
+with integrators, reflexes and re-planning (``roughwalk.run``). Speed is the
+straight-line distance from the start feet centroid to the goal over the
+time from the first motion to reaching it: every wait for optimisation and
+every re-plan counts, measured in wall time on this machine.
+
+Terrain classes: large rocks, round rocks, sloped rocks and logs on the
+shared LittleDog boards (``../shared/terrains/littledog``: AE, AC, Y, AD)
+when present, crossed from one side to the other, with the seed jittering
+the start; and on the generators (a new course per seed) otherwise; gap,
+barrier and steps (≤ 10.8 cm) on the generators. ``--disturbances`` adds
+runs on generated large rocks under a lateral push, a friction drop and a
+±1 cm error in the map the planner sees, and reports how many runs the
+reflexes and re-planning rescued (succeeded after at least one reflex).
+
+Run: ``roughwalk bench littledog [--seeds N] [--full] [--disturbances]``.
+Writes ``benchmarks/results/littledog.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import roughwalk as rw
+from roughwalk.cli.common import machine_description, result_envelope, write_json
+from roughwalk.sim import FrictionDrop, MapError, Push, run
+
+RESULTS = Path(__file__).resolve().parent / "results" / "littledog.json"
+SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "terrains" / "littledog"
+BOARDS = {"large_rocks": "AE", "round_rocks": "AC", "sloped_rocks": "Y", "logs": "AD"}
+CLASSES = ("large_rocks", "round_rocks", "sloped_rocks", "logs", "gap", "barrier", "steps")
+TARGET_CM_S = 7.2
+
+
+def course(
+    kind: str, seed: int, full: bool
+) -> tuple[str, tuple[float, float, float], tuple[float, float]]:
+    """Terrain spec, start (x, y, yaw) and goal (x, y) of run ``seed`` of a terrain class."""
+    rng = np.random.default_rng(seed)
+    jitter = (rng.uniform(-0.02, 0.02), rng.uniform(-0.01, 0.01), rng.uniform(-0.05, 0.05))
+    board = SHARED / f"terrain{BOARDS[kind]}.mat" if kind in BOARDS else None
+    if board is not None and board.is_file():
+        t = rw.load_terrain(str(board))
+        x0, x1, y0, y1 = t.extent
+        yc = 0.5 * (y0 + y1)
+        start = (x0 + 0.17 + jitter[0], yc + jitter[1], jitter[2])
+        return str(board), start, (x1 - 0.15, yc)
+    randomized = kind not in ("gap", "barrier", "steps")
+    spec = f"{kind}:seed={seed}" if randomized else kind
+    length = 1.5 if full else 0.8
+    start = (0.25 + jitter[0], jitter[1], jitter[2])
+    return spec, start, (0.25 + length, 0.0)
+
+
+def one_run(
+    spec: str,
+    start: tuple[float, float, float],
+    goal: tuple[float, float],
+    plan_time: float,
+    disturbances: list[Any],
+) -> dict[str, Any]:
+    """Run once; the result's JSON fields plus the wall time."""
+    began = time.perf_counter()
+    result = run(
+        "littledog",
+        spec,
+        start,
+        goal,
+        disturbances=disturbances,
+        **{"executor.initial_plan_s": plan_time},
+    )
+    out = result.to_dict()
+    out["wall_s"] = time.perf_counter() - began
+    out["rescued"] = bool(out["success"] and out["reflexes"] > 0)
+    return out
+
+
+def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    """Success rate, speeds of the successful runs, counts."""
+    ok = [r for r in runs if r["success"]]
+    speeds = [r["speed_cm_s"] for r in ok]
+    return {
+        "runs": len(runs),
+        "success_rate": len(ok) / len(runs) if runs else math.nan,
+        "speed_cm_s_mean": float(np.mean(speeds)) if speeds else None,
+        "speed_cm_s_min": float(np.min(speeds)) if speeds else None,
+        "reflexes": int(sum(r["reflexes"] for r in runs)),
+        "replans": int(sum(r["replans"] for r in runs)),
+        "rescued": int(sum(r["rescued"] for r in runs)),
+        "wait_s": float(sum(r["wait_s"] for r in runs)),
+        "failures": sorted({r["reason"] for r in runs if not r["success"]}),
+    }
+
+
+def print_row(name: str, s: dict[str, Any]) -> None:
+    """One line of the table."""
+    speed = f"{s['speed_cm_s_mean']:.2f}" if s["speed_cm_s_mean"] is not None else "—"
+    ok = s["speed_cm_s_mean"] is not None and s["success_rate"] >= 0.95
+    met = "yes" if ok and s["speed_cm_s_mean"] >= TARGET_CM_S else "no"
+    print(
+        f"{name:<28} {s['runs']:>4} {100 * s['success_rate']:>7.0f}% {speed:>9} "
+        f"{s['reflexes']:>8} {s['replans']:>7} {s['rescued']:>7} {s['wait_s']:>7.1f} {met:>6}",
+        flush=True,
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the benchmark, print the table, write the JSON."""
+    ap = argparse.ArgumentParser(
+        prog="roughwalk bench littledog", description=__doc__.split("\n")[0]
+    )
+    ap.add_argument(
+        "--seeds", type=int, default=None, help="runs per terrain class (default 2; 10 with --full)"
+    )
+    ap.add_argument(
+        "--full",
+        action="store_true",
+        help="the real protocol: 10 seeds, 1.5 m courses, disturbances",
+    )
+    ap.add_argument("--disturbances", action="store_true", help="add the disturbance runs")
+    ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated terrain classes")
+    ap.add_argument(
+        "--plan-time", type=float, default=5.0, help="planning before the clock starts [s]"
+    )
+    ap.add_argument("--push", type=float, default=0.6, help="lateral push impulse [N·s]")
+    ap.add_argument("--json", default=str(RESULTS), help="where to write the results")
+    args = ap.parse_args(argv)
+    seeds = args.seeds if args.seeds is not None else (10 if args.full else 2)
+    classes = [c.strip() for c in args.classes.split(",") if c.strip()]
+    unknown = set(classes) - set(CLASSES)
+    if unknown:
+        ap.error(f"unknown terrain classes {sorted(unknown)}; known: {', '.join(CLASSES)}")
+    header = (
+        f"{'terrain class':<28} {'runs':>4} {'success':>8} {'cm/s':>9} {'reflexes':>8} "
+        f"{'replans':>7} {'rescued':>7} {'wait s':>7} {'target':>6}"
+    )
+    print(f"LittleDog in MuJoCo, {seeds} runs per class; target ≥95% at ≥{TARGET_CM_S} cm/s")
+    print(header)
+    print("-" * len(header))
+    table: dict[str, Any] = {}
+    for kind in classes:
+        runs = []
+        for seed in range(seeds):
+            spec, start, goal = course(kind, seed, args.full)
+            r = one_run(spec, start, goal, args.plan_time, [])
+            r["seed"] = seed
+            runs.append(r)
+        table[kind] = {"summary": summarize(runs), "runs": runs}
+        print_row(kind, table[kind]["summary"])
+    if args.disturbances or args.full:
+        cases = {
+            f"push {args.push:g} N·s": lambda seed: [Push(args.push, at_s=2.0 + 0.7 * seed)],
+            "friction 0.5": lambda seed: [FrictionDrop(0.5)],
+            "map error ±1 cm": lambda seed: [MapError(0.01, seed=seed)],
+        }
+        for name, make in cases.items():
+            runs = []
+            for seed in range(seeds):
+                spec, start, goal = course("large_rocks", seed + 100, args.full)
+                if spec.endswith(".mat"):
+                    spec = f"large_rocks:seed={seed}"
+                    start, goal = (0.25, 0.0, 0.0), (1.05, 0.0)
+                r = one_run(spec, start, goal, args.plan_time, make(seed))
+                r["seed"] = seed
+                runs.append(r)
+            key = f"large_rocks + {name}"
+            table[key] = {"summary": summarize(runs), "runs": runs}
+            print_row(key, table[key]["summary"])
+    write_json(
+        args.json,
+        result_envelope(
+            "bench_littledog",
+            robot="littledog",
+            machine=machine_description(),
+            seeds=seeds,
+            full=args.full,
+            plan_time_s=args.plan_time,
+            target_cm_s=TARGET_CM_S,
+            classes=table,
+        ),
+    )
+    print(f"wrote {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
