@@ -44,7 +44,7 @@ from roughwalk.trajopt.variables import (
 
 __all__ = ["Formulation", "TaskSymbols"]
 
-_ROWS_PER_BLOCK = 6
+_ROWS_PER_BLOCK = 6  # constraint rows differentiated together (one dynamics sample)
 
 
 @dataclass(frozen=True)
@@ -301,8 +301,12 @@ class Formulation:
         for rows in self.rows:
             for start in range(0, rows.size, _ROWS_PER_BLOCK):
                 stop = min(start + _ROWS_PER_BLOCK, rows.size)
+                chunk = rows.expr[start:stop]
+                # Linear rows (start, goal, apex, most bounds) have no curvature.
+                if not any(ca.which_depends(chunk, z, 2, True)):
+                    continue
                 weights = lam_g[offset + start : offset + stop]
-                blocks.append(ca.hessian(ca.dot(weights, rows.expr[start:stop]), z)[0])
+                blocks.append(ca.hessian(ca.dot(weights, chunk), z)[0])
             offset += rows.size
         for cost in self.costs:
             blocks.append(lam_f * ca.hessian(ca.SX(cost.expr), z)[0])
