@@ -128,3 +128,49 @@ def test_robot_show_and_info_cli(tmp_path: Path) -> None:
     assert main(["robot", "show", "anymal_c", "-o", str(png)]) == 0
     assert png.stat().st_size > 20_000
     assert main(["robot", "info", "anymel"]) == 1
+
+
+def _brute_capsule_distance(terrain, wa, wb, radius) -> float:
+    """Capsule-to-terrain distance by dense sampling of both (no SDF code)."""
+    from scipy.spatial import cKDTree
+
+    lo = np.minimum(wa, wb) - radius - 0.03
+    hi = np.maximum(wa, wb) + radius + 0.03
+    xs = np.arange(lo[0], hi[0], 0.001)
+    ys = np.arange(lo[1], hi[1], 0.001)
+    gx, gy = np.meshgrid(xs, ys, indexing="ij")
+    xy = np.column_stack([gx.ravel(), gy.ravel()])
+    surface = np.column_stack([xy, terrain.height(xy)])
+    t = np.linspace(0, 1, 200)[:, None]
+    axis = wa + t * (wb - wa)
+    dist, _ = cKDTree(surface).query(axis)
+    return float(dist.min() - radius)
+
+
+def test_whole_body_distance_matches_brute_force_and_names_the_link() -> None:
+    robot = roughwalk.load_robot("littledog")
+    terrain = roughwalk.load_terrain("barrier:resolution=0.004")
+    sdf = terrain.sdf(resolution=0.004)
+    cm = CollisionModel.from_robot(robot)
+    q = robot.nominal_q
+    # Trunk over the barrier, low enough that a leg link is the closest part.
+    x_barrier = float(terrain.x[np.argmax(terrain.heights.max(axis=1))])
+    base = np.array([x_barrier - 0.09, 0.0, robot.nominal_stance.base_height + 0.02])
+    res = cm.distance(robot, sdf, q, base)
+    wa, wb = cm.world_segments(robot, q, base)
+    assert np.isinf(res.per_primitive[cm.is_foot]).all()
+    k = res.primitive
+    assert not cm.is_foot[k] and res.leg == cm.leg[k] and res.link == cm.link[k]
+    exact = _brute_capsule_distance(terrain, wa[k], wb[k], cm.radius[k])
+    voxel_half_diag = 0.5 * np.sqrt(3) * 0.004
+    assert abs(res.distance - exact) <= voxel_half_diag + 1e-3
+    # The minimum really is the minimum over the non-foot primitives.
+    assert res.distance == pytest.approx(np.min(res.per_primitive))
+    # Moving the closest point along the gradient increases the distance (first order).
+    d_here, _ = sdf.query(res.point[None, :])
+    d_moved, _ = sdf.query((res.point + 1e-3 * res.gradient)[None, :])
+    assert d_moved[0] > d_here[0]
+    # Feet included: the feet touch the ground in a nominal stance on the pad.
+    flat = np.array([0.15, 0.0, robot.nominal_stance.base_height])
+    with_feet = cm.distance(robot, sdf, q, flat, exclude_feet=False)
+    assert cm.is_foot[with_feet.primitive] and abs(with_feet.distance) < 3e-3

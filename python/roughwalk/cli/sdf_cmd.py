@@ -30,6 +30,7 @@ def cmd_sdf(args: argparse.Namespace) -> int:
     info(f"building the SDF of {t} at {cfg.resolution * 1000:g} mm ...")
     sdf = SignedDistanceField.build(t, config=cfg)
     summary = sdf.info()
+    summary.pop("terrain", None)  # the envelope carries the terrain spec
     info(
         f"built {summary['shape']} voxels in {summary['build_time_s']:.3f} s "
         f"(EDT backend: {summary['backend']})"

@@ -38,8 +38,9 @@ from roughwalk.robots._rotations import quat_to_matrix
 
 if TYPE_CHECKING:
     from roughwalk.robots.robot import Robot
+    from roughwalk.terrain.sdf import SignedDistanceField
 
-__all__ = ["CollisionModel", "capsules_for_box"]
+__all__ = ["CollisionModel", "WholeBodyDistance", "capsules_for_box"]
 
 TRUNK = -1
 
@@ -64,6 +65,29 @@ def capsules_for_box(
         e[order[0]] = a
         out.append((p - e, p + e, radius))
     return out
+
+
+@dataclass(frozen=True)
+class WholeBodyDistance:
+    """The robot's least signed distance to the terrain and where it is attained.
+
+    ``distance`` [m] is the capsule surface's distance (negative: penetration);
+    ``point`` (3,) the world point on the capsule's axis where the field is
+    least, ``gradient`` (3,) the field's gradient there (moving ``point``
+    along it increases the distance); ``primitive`` its row in the model,
+    ``leg`` (−1 trunk) and ``link`` (−1 trunk) its owner, ``point_in_link``
+    (3,) the same point in that link's frame (the base frame for the trunk);
+    ``per_primitive`` (N,) every primitive's distance [m] (+inf if excluded).
+    """
+
+    distance: float
+    point: NDArray[np.float64]
+    gradient: NDArray[np.float64]
+    primitive: int
+    leg: int
+    link: int
+    point_in_link: NDArray[np.float64]
+    per_primitive: NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -176,19 +200,56 @@ class CollisionModel:
         qc = robot.to_canonical(np.asarray(q, dtype=float)).reshape(4, 3)
         rot = quat_to_matrix(np.asarray(base_quat, dtype=float))
         pos = np.asarray(base_pos, dtype=float)
-        frames = [
-            reference_fk.leg_link_frames(leg, qc[i]) for i, leg in enumerate(robot.leg_descriptions)
-        ]
-        wa = np.empty_like(self.a)
-        wb = np.empty_like(self.b)
-        for k in range(len(self)):
-            if self.leg[k] == TRUNK:
-                la, lb = self.a[k], self.b[k]
-            else:
-                p, r = frames[self.leg[k]]
-                link = self.link[k]
-                la = p[link] + r[link] @ self.a[k]
-                lb = p[link] + r[link] @ self.b[k]
-            wa[k] = pos + rot @ la
-            wb[k] = pos + rot @ lb
+        # One frame per link (13 with the trunk), then every primitive at once.
+        origins = np.zeros((13, 3))
+        rotations = np.tile(np.eye(3), (13, 1, 1))
+        for i, leg in enumerate(robot.leg_descriptions):
+            p, r = reference_fk.leg_link_frames(leg, qc[i])
+            origins[1 + 3 * i : 4 + 3 * i] = p
+            rotations[1 + 3 * i : 4 + 3 * i] = r
+        slot = np.where(self.leg == TRUNK, 0, 1 + 3 * self.leg + self.link)
+        la = origins[slot] + np.einsum("nij,nj->ni", rotations[slot], self.a)
+        lb = origins[slot] + np.einsum("nij,nj->ni", rotations[slot], self.b)
+        wa = pos + la @ rot.T
+        wb = pos + lb @ rot.T
         return wa, wb
+
+    def distance(
+        self,
+        robot: Robot,
+        sdf: SignedDistanceField,
+        q: ArrayLike,
+        base_pos: ArrayLike = (0.0, 0.0, 0.0),
+        base_quat: ArrayLike = (1.0, 0.0, 0.0, 0.0),
+        *,
+        exclude_feet: bool = True,
+    ) -> WholeBodyDistance:
+        """Whole-body signed distance to the terrain SDF at q (12,) and the base pose.
+
+        One batched capsule query in the Rust core (min over samples along each
+        segment minus its radius, as Zucker 2011 §3.3 does); feet are left out
+        unless ``exclude_feet`` is False.
+        """
+        wa, wb = self.world_segments(robot, q, base_pos, base_quat)
+        keep = ~self.is_foot if exclude_feet else np.ones(len(self), dtype=bool)
+        if not keep.any():
+            raise RobotModelError("every collision primitive is a foot; nothing to measure")
+        d, g, t = sdf.query_capsules(wa[keep], wb[keep], self.radius[keep], return_fraction=True)
+        per = np.full(len(self), np.inf)
+        per[keep] = d
+        rows = np.flatnonzero(keep)
+        best = int(np.argmin(d))
+        k = int(rows[best])
+        frac = float(t[best])
+        point = wa[k] + frac * (wb[k] - wa[k])
+        local = self.a[k] + frac * (self.b[k] - self.a[k])
+        return WholeBodyDistance(
+            distance=float(d[best]),
+            point=point,
+            gradient=np.asarray(g[best], dtype=float),
+            primitive=k,
+            leg=int(self.leg[k]),
+            link=int(self.link[k]),
+            point_in_link=local,
+            per_primitive=per,
+        )
