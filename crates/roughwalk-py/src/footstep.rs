@@ -67,6 +67,7 @@ fn parse_config(d: &Bound<'_, PyDict>) -> PyResult<FootstepConfig> {
     let c: Bound<'_, PyDict> = item(d, "certificate")?;
     let certificate = CertificateConfig {
         max_iterations: item(&c, "max_iterations")?,
+        stall_rounds: item(&c, "stall_rounds")?,
         alpha_reach: item(&c, "alpha_reach")?,
         beta_reach: item(&c, "beta_reach")?,
         reach_overshoot: item(&c, "reach_overshoot")?,
@@ -186,6 +187,7 @@ fn result_dict<'py>(py: Python<'py>, r: &FootstepPlanResult) -> PyResult<Bound<'
         .collect();
     d.set_item("iterations", iterations)?;
     d.set_item("certificates_computed", r.model.certificates_computed)?;
+    d.set_item("certificate_rounds", r.model.certificate_rounds)?;
     d.set_item("certificate_cache_hits", r.model.certificate_cache_hits)?;
     d.set_item(
         "certificate_failures",

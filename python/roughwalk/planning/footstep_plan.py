@@ -153,6 +153,9 @@ class FootstepPlan:
         Time in the search, and of the whole call [s].
     certificate_cache_hits:
         Actions whose certificate outcome came from the cache.
+    certificate_rounds:
+        Correction rounds of the certificates found (1 when the guessed pose
+        needed none), summed.
     certificate_failures:
         Failed certificate searches by what was left to correct:
         ``{"unreachable", "center_of_mass", "collision"}``.
@@ -184,6 +187,7 @@ class FootstepPlan:
     search_s: float
     elapsed_s: float
     certificate_cache_hits: int
+    certificate_rounds: int
     certificate_failures: dict[str, int]
     tree: NDArray[np.float64] = field(repr=False)
     robot: str = ""
@@ -247,6 +251,7 @@ class FootstepPlan:
             "search_s": self.search_s,
             "elapsed_s": self.elapsed_s,
             "certificate_cache_hits": self.certificate_cache_hits,
+            "certificate_rounds": self.certificate_rounds,
             "certificate_failures": dict(self.certificate_failures),
             "robot": self.robot,
             "terrain": self.terrain,

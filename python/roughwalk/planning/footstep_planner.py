@@ -331,6 +331,7 @@ class FootstepPlanner:
             search_s=float(raw["search_s"]),
             elapsed_s=float(raw["elapsed_s"]),
             certificate_cache_hits=int(raw["certificate_cache_hits"]),
+            certificate_rounds=int(raw["certificate_rounds"]),
             certificate_failures=dict(zip(_FAILURES, (int(v) for v in failures), strict=True)),
             tree=np.asarray(raw["tree"], dtype=float).reshape(-1, 5),
             robot=self.robot.name,

@@ -19,8 +19,8 @@ use crate::footstep::mass_model::MassModel;
 use crate::kinematics::body_pose::point_pose_jacobians;
 use crate::kinematics::leg::{IkResult, LegChain, LinkFrames};
 use crate::kinematics::math::{
-    add, cross, det, exp_so3, mat_mul, mat_t_vec, mat_to_quat, mat_vec, norm, scale, sub, Mat3,
-    Quat, Vec3,
+    add, cross, det, dot, exp_so3, mat_mul, mat_t_vec, mat_to_quat, mat_vec, norm, scale, sub,
+    Mat3, Quat, Vec3,
 };
 use crate::kinematics::quadruped::{BodyPose, Quadruped};
 use crate::kinematics::support::support_triangle_incircle;
@@ -29,16 +29,15 @@ use crate::sdf::SignedDistanceField;
 /// A point in the x–y plane [m].
 pub type Vec2 = [f64; 2];
 
-/// The CoM correction aims this far past the margin [m], so that the next
-/// round finds no correction to make.
-const COM_AIM: f64 = 5e-4;
+/// The CoM correction aims this fraction of the margin deeper than the
+/// margin, so that the CoM's shift with the legs' joint angles in the next
+/// round does not call for another correction.
+const COM_AIM: f64 = 0.3;
 
-/// A search whose total violation (foot errors, CoM and clearance deficits)
-/// has not dropped by a tenth below its best for this many rounds is
-/// stuck — typically a shin against a rock that no trunk motion frees — and
-/// gives up early: on rough ground most rejected actions end this way, and
-/// running them to the round limit would cost most of the planning time.
-const STALL_ROUNDS: u32 = 4;
+/// The guessed pose keeps every foot within this fraction of its leg's
+/// reach, lowering the trunk if need be: stretched legs otherwise cost a
+/// reachability round on most forward steps.
+const REACH_FRACTION: f64 = 0.97;
 
 /// The shell a leg's foot can reach: distances [m] from its HAA joint
 /// anchor (base frame), found by sampling the joint box.
@@ -271,10 +270,12 @@ pub struct CertificateSearch<'a> {
 impl CertificateSearch<'_> {
     /// The trunk pose guessed from the footholds: over the feet's centroid at
     /// the nominal height above their mean contact height, facing `heading`
-    /// [rad], tilted like the feet (clamped to `max_tilt`), and shifted so
-    /// that the nominal centre of mass sits over the support triangle.
+    /// [rad], tilted like the feet (clamped to `max_tilt`), shifted so that
+    /// the nominal centre of mass sits over the support triangle, and
+    /// lowered until the foot centres `feet` are within reach.
     pub fn initial_pose(
         &self,
+        feet: &[Vec3; 4],
         contacts: &[Vec3; 4],
         support: &[usize; 3],
         heading: f64,
@@ -314,10 +315,25 @@ impl CertificateSearch<'_> {
         ];
         let com = add(x, mat_vec(&r, self.nominal_com));
         let tri = support.map(|leg| [contacts[leg][0], contacts[leg][1]]);
-        let target =
-            closest_point_in_triangle([com[0], com[1]], &tri, self.config.com_margin + COM_AIM);
+        let target = closest_point_in_triangle(
+            [com[0], com[1]],
+            &tri,
+            (1.0 + COM_AIM) * self.config.com_margin,
+        );
         x[0] += target[0] - com[0];
         x[1] += target[1] - com[1];
+        // Lower the trunk until every foot is within reach of its hip:
+        // |hip − dz·ẑ − f| = REACH_FRACTION · reach.
+        let mut drop: f64 = 0.0;
+        for (i, reach) in self.reach.iter().enumerate() {
+            let v = sub(add(x, mat_vec(&r, reach.hip)), feet[i]);
+            let limit = REACH_FRACTION * reach.max;
+            let horizontal = v[0] * v[0] + v[1] * v[1];
+            if horizontal < limit * limit {
+                drop = drop.max(v[2] - (limit * limit - horizontal).sqrt());
+            }
+        }
+        x[2] -= drop;
         BodyPose { x, r }
     }
 
@@ -347,10 +363,10 @@ impl CertificateSearch<'_> {
         let required = cfg.clearance + self.sdf_error;
         let cutoff = required.max(cfg.preferred_clearance + self.sdf_error);
         let spacing = self.sdf.grid().spec().resolution;
-        let mut pose = self.initial_pose(contacts, support, heading);
+        let mut pose = self.initial_pose(feet, contacts, support, heading);
         let start = pose.x;
         let mut failure = CertificateFailure::Unreachable;
-        let (mut best, mut stalled) = (f64::INFINITY, 0);
+        let (mut best, mut stalled) = (f64::INFINITY, 0usize);
         for iteration in 1..=cfg.max_iterations {
             let mut violation = 0.0;
             let mut dx = [0.0; 3];
@@ -410,8 +426,11 @@ impl CertificateSearch<'_> {
             let com_ok = com_margin >= cfg.com_margin;
             if !com_ok {
                 violation += cfg.com_margin - com_margin;
-                let target =
-                    closest_point_in_triangle([com[0], com[1]], &tri, cfg.com_margin + COM_AIM);
+                let target = closest_point_in_triangle(
+                    [com[0], com[1]],
+                    &tri,
+                    (1.0 + COM_AIM) * cfg.com_margin,
+                );
                 dx = add(dx, [target[0] - com[0], target[1] - com[1], 0.0]);
             }
             let closest = self
@@ -436,7 +455,7 @@ impl CertificateSearch<'_> {
                 (best, stalled) = (violation, 0);
             } else {
                 stalled += 1;
-                if stalled >= STALL_ROUNDS {
+                if stalled >= cfg.stall_rounds {
                     break;
                 }
             }
@@ -458,8 +477,12 @@ impl CertificateSearch<'_> {
         Err(failure)
     }
 
-    /// Zucker 2011, §3.4: Δx = α·J_p(x)ᵀ·g, ω = β·J_p(R)ᵀ·g at the point of
-    /// least clearance, g scaled by how far it must move.
+    /// Zucker 2011, §3.4: Δx = α·s·J_p(x)ᵀ·g, ω = β·s·J_p(R)ᵀ·g at the point
+    /// of least clearance. The paper's direction; its length s is chosen so
+    /// that the point's linearised motion along g, s·(α|J_xᵀg|² + β|J_Rᵀg|²),
+    /// equals the distance it must gain — a fixed gain instead took four or
+    /// more rounds for most collisions on rough boards, each with a full
+    /// collision check. α and β weigh translation against rotation.
     fn obstacle_step(
         &self,
         feet: &[Vec3; 4],
@@ -474,16 +497,19 @@ impl CertificateSearch<'_> {
         if g_len == 0.0 {
             return;
         }
-        let g = scale(
-            c.gradient,
-            (required + cfg.clearance_overshoot - c.distance) / g_len,
-        );
+        let g = scale(c.gradient, 1.0 / g_len);
         let Ok(jac) = point_pose_jacobians(self.robot, feet, pose.x, mat_to_quat(&pose.r), c.point)
         else {
             return;
         };
-        *dx = add(*dx, scale(mat_t_vec(&jac.j_x, g), cfg.alpha_obstacle));
-        *omega = add(*omega, scale(mat_t_vec(&jac.j_r, g), cfg.beta_obstacle));
+        let (a, b) = (mat_t_vec(&jac.j_x, g), mat_t_vec(&jac.j_r, g));
+        let gain = cfg.alpha_obstacle * dot(a, a) + cfg.beta_obstacle * dot(b, b);
+        if gain <= 1e-12 {
+            return;
+        }
+        let s = (required + cfg.clearance_overshoot - c.distance) / gain;
+        *dx = add(*dx, scale(a, cfg.alpha_obstacle * s));
+        *omega = add(*omega, scale(b, cfg.beta_obstacle * s));
     }
 
     fn certificate(
@@ -668,7 +694,7 @@ mod tests {
             reach: &reach,
         };
         let (feet, contacts) = stance(&height, [0.3, 0.0], 0.0);
-        let guess = search.initial_pose(&contacts, &[1, 2, 3], 0.0);
+        let guess = search.initial_pose(&feet, &contacts, &[1, 2, 3], 0.0);
         let frames: [LinkFrames; 4] = std::array::from_fn(|i| {
             let ik = robot.legs()[i].ik(guess.to_body(feet[i]), None);
             robot.legs()[i].link_frames(ik.q)

@@ -41,6 +41,12 @@ impl HeuristicKind {
 pub struct CertificateConfig {
     /// Most trunk corrections before giving up (the paper's 25).
     pub max_iterations: usize,
+    /// The search also gives up when its total violation (foot errors, CoM
+    /// and clearance deficits) has not dropped a tenth below its best for
+    /// this many rounds: stuck, typically a shin against a rock no trunk
+    /// motion frees. On rough boards most rejected actions end this way,
+    /// and running them to `max_iterations` would cost most of the time.
+    pub stall_rounds: usize,
     /// Translation step α of the reachability correction (§3.2) [1].
     pub alpha_reach: f64,
     /// Rotation step β of the reachability correction [rad/m²].
@@ -163,10 +169,11 @@ fn non_negative(name: &str, v: f64) -> CoreResult<()> {
 impl CertificateConfig {
     /// Checks every field.
     pub fn validate(&self) -> CoreResult<()> {
-        if self.max_iterations == 0 {
-            return Err(CoreError::Planning(
-                "footstep config: certificate.max_iterations must be >= 1, got 0".into(),
-            ));
+        if self.max_iterations == 0 || self.stall_rounds == 0 {
+            return Err(CoreError::Planning(format!(
+                "footstep config: certificate.max_iterations ({}) and stall_rounds ({}) must be >= 1",
+                self.max_iterations, self.stall_rounds
+            )));
         }
         for (name, v) in [
             ("certificate.alpha_reach", self.alpha_reach),
@@ -302,6 +309,7 @@ pub(crate) mod tests {
             incircle_penalty: 1.0,
             certificate: CertificateConfig {
                 max_iterations: 25,
+                stall_rounds: 3,
                 alpha_reach: 0.7,
                 beta_reach: 0.5 / (0.5 * l * 0.5 * l),
                 reach_overshoot: 0.002,

@@ -70,6 +70,9 @@ pub struct TreeEdge {
 pub struct ModelCounters {
     /// Certificate searches run (cache misses): the actions evaluated.
     pub certificates_computed: u64,
+    /// Correction rounds of the certificates found (their mean is how good
+    /// the guessed starting pose is).
+    pub certificate_rounds: u64,
     /// Certificate outcomes taken from the cache.
     pub certificate_cache_hits: u64,
     /// Certificate searches that failed, by what was left to correct:
@@ -327,7 +330,10 @@ impl FootstepModel {
             self.counters.certificate_cache_hits += 1;
             return (o, false);
         }
-        let outcome = self.certify(s).map(|c| c.penalty);
+        let outcome = self.certify(s).map(|c| {
+            self.counters.certificate_rounds += u64::from(c.iterations);
+            c.penalty
+        });
         self.counters.certificates_computed += 1;
         if let Err(f) = outcome {
             self.counters.certificate_failures[f as usize] += 1;
