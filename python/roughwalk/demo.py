@@ -17,9 +17,11 @@ from roughwalk.terrain import load_terrain
 
 __all__ = ["run_demo", "DEFAULT_DEMO_TERRAIN"]
 
-DEFAULT_DEMO_TERRAIN = "large_rocks:seed=7"
+# Rocks up to 5 cm: the walk on this course succeeds today; on the full 10.8 cm
+# LittleDog rocks it still falls too often (`roughwalk bench littledog` says how often).
+DEFAULT_DEMO_TERRAIN = "large_rocks:seed=7,max_height=0.05"
 DEMO_START = (0.25, 0.0, 0.0)
-DEMO_GOAL = (1.0, 0.0)
+DEMO_GOAL = (0.85, 0.0)
 
 
 def run_demo(
