@@ -15,6 +15,22 @@ use crate::sdf::SignedDistanceField;
 /// closer than the cut-off.
 const LIPSCHITZ: f64 = 1.732_050_808_568_877_3;
 
+/// The field's value [m] at `p` without its gradient (the trilinear value of
+/// the lattice cell, or the exact fall-back outside the lattice): capsule
+/// marching needs only values, and the gradient only at the minimum.
+#[inline]
+fn distance(sdf: &SignedDistanceField, p: Vec3) -> f64 {
+    let grid = sdf.grid();
+    let Some((base, [tx, ty, tz])) = grid.locate(p) else {
+        return sdf.distance_and_gradient(p).0;
+    };
+    let c = grid.corners(base).map(f64::from);
+    let lerp = |a: f64, b: f64, t: f64| a + (b - a) * t;
+    let f0 = lerp(lerp(c[0], c[1], tz), lerp(c[2], c[3], tz), ty);
+    let f1 = lerp(lerp(c[4], c[5], tz), lerp(c[6], c[7], tz), ty);
+    lerp(f0, f1, tx)
+}
+
 /// A capsule fixed to the trunk or to a leg link (a sphere when a = b).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Capsule {
@@ -111,13 +127,14 @@ impl CollisionModel {
         cutoff: f64,
         spacing: f64,
     ) -> Option<Clearance> {
-        let mut best: Option<Clearance> = None;
+        // (distance, capsule, fraction along it, world point)
+        let mut best: Option<(f64, usize, f64, Vec3)> = None;
         let mut bound = cutoff;
         for (k, c) in self.capsules.iter().enumerate() {
             let (wa, wb) = self.world_segment(k, pose, frames);
             let ab = sub(wb, wa);
             let length = norm(ab);
-            let (d_mid, _) = sdf.distance_and_gradient(add(wa, scale(ab, 0.5)));
+            let d_mid = distance(sdf, add(wa, scale(ab, 0.5)));
             if d_mid - c.radius - LIPSCHITZ * 0.5 * length >= bound {
                 continue;
             }
@@ -125,25 +142,10 @@ impl CollisionModel {
             loop {
                 let f = if length > 0.0 { t / length } else { 0.0 };
                 let p = add(wa, scale(ab, f));
-                let (d, g) = sdf.distance_and_gradient(p);
-                let v = d - c.radius;
+                let v = distance(sdf, p) - c.radius;
                 if v < bound {
                     bound = v;
-                    let local = add(c.a, scale(sub(c.b, c.a), f));
-                    best = Some(Clearance {
-                        distance: v,
-                        point: match c.leg {
-                            None => CollisionPoint::Trunk(local),
-                            Some(leg) => CollisionPoint::Leg {
-                                leg,
-                                link: c.link,
-                                point: local,
-                            },
-                        },
-                        world: p,
-                        gradient: g,
-                        capsule: k,
-                    });
+                    best = Some((v, k, f, p));
                 }
                 if t >= length {
                     break;
@@ -151,7 +153,24 @@ impl CollisionModel {
                 t = (t + spacing.max((v - bound) / LIPSCHITZ)).min(length);
             }
         }
-        best
+        best.map(|(v, k, f, p)| {
+            let c = &self.capsules[k];
+            let local = add(c.a, scale(sub(c.b, c.a), f));
+            Clearance {
+                distance: v,
+                point: match c.leg {
+                    None => CollisionPoint::Trunk(local),
+                    Some(leg) => CollisionPoint::Leg {
+                        leg,
+                        link: c.link,
+                        point: local,
+                    },
+                },
+                world: p,
+                gradient: sdf.distance_and_gradient(p).1,
+                capsule: k,
+            }
+        })
     }
 }
 
@@ -241,6 +260,23 @@ pub(crate) mod tests {
             }
         }
         best
+    }
+
+    #[test]
+    fn footstep_value_only_queries_match_the_field() {
+        let (_, sdf) = sdf_of(|x, y| 0.04 * (20.0 * x).sin() * (15.0 * y).cos());
+        let mut worst: f64 = 0.0;
+        for k in 0..2000 {
+            let f = f64::from(k);
+            // Inside the lattice and, for some, above or beside it (fall-back).
+            let p = [
+                (f * 0.618_033_9).fract() * 0.7 - 0.05,
+                (f * 0.414_213_5).fract() * 0.7 - 0.35,
+                (f * 0.732_050_8).fract() * 0.6 - 0.1,
+            ];
+            worst = worst.max((distance(&sdf, p) - sdf.distance_and_gradient(p).0).abs());
+        }
+        assert!(worst < 1e-12, "{worst}");
     }
 
     #[test]
