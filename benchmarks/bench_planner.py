@@ -120,7 +120,7 @@ def run_course(name: str, robot: rw.Robot, time_limit: float) -> dict[str, Any]:
     return row
 
 
-def run_golden(robot: rw.Robot, factor: int = 20) -> dict[str, Any]:
+def run_golden(robot: rw.Robot, factor: int = 200) -> dict[str, Any]:
     """Expansions to the first plan of the sideways scenario, per heuristic."""
     scenario = json.loads(GOLDEN.read_text())
     terrain = rw.load_terrain(scenario["terrain"])

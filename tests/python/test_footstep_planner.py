@@ -291,3 +291,20 @@ def test_plan_footsteps_is_the_one_call_form(robot: rw.Robot, rocks_plan: Any) -
     assert plan.footsteps == rocks_plan.footsteps
     euclid = plan_footsteps(robot, terrain, START, GOAL, None, expansions=50, heuristic="euclidean")
     assert euclid.heuristic == "euclidean" and euclid.bound_guaranteed
+
+
+@pytest.mark.parametrize("name", [info.name for info in rw.robots.list_robots()])
+def test_every_registered_robot_plans_across_flat_ground(name: str) -> None:
+    robot = rw.load_robot(name)
+    config = FootstepConfig.for_robot(robot)
+    length = hip_to_hip_length(robot)
+    terrain = rw.load_terrain(f"flat:length={6 * length:.3f},width={3 * length:.3f}")
+    start = (1.5 * length, 0.0, 0.0)
+    goal = (4.0 * length, 0.3 * length)
+    plan = FootstepPlanner(robot, terrain, config).plan(
+        start, goal, time_limit=None, expansions=200
+    )
+    assert plan.status == "solved", plan.reason
+    final = plan.stances()[-1][:, :2].mean(axis=0)
+    assert math.dist(final, goal) <= config.goal_radius + 1e-9
+    assert sum(plan.certificate_failures.values()) == 0

@@ -20,12 +20,33 @@ from roughwalk.errors import ConfigError
 if TYPE_CHECKING:
     from roughwalk.robots.robot import Robot
 
-__all__ = ["CertificateConfig", "FootstepConfig", "WALKING_ORDERS", "hip_to_hip_length"]
+__all__ = [
+    "CertificateConfig",
+    "FootstepConfig",
+    "WALKING_ORDERS",
+    "hip_to_hip_length",
+    "nominal_body_clearance",
+]
 
 # Canonical leg indices: 0 LF, 1 RF, 2 LH, 3 RH.
 LEG_INDEX = {"LF": 0, "RF": 1, "LH": 2, "RH": 3}
 # The statically stable crawl: each hind leg is followed by the front leg on its side.
 WALKING_ORDERS = {"crawl": ("LH", "LF", "RH", "RF")}
+
+
+def nominal_body_clearance(robot: Robot) -> float:
+    """Least clearance [m] of the body, feet excluded, at the nominal stance on flat ground.
+
+    LittleDog's is 21 mm (its shins' lower ends), ANYmal C's 17 mm.
+    """
+    from roughwalk.robots.collision_model import CollisionModel
+
+    model = CollisionModel.from_robot(robot)
+    height = robot.nominal_stance.base_height
+    a, b = model.world_segments(robot, robot.nominal_q, (0.0, 0.0, height))
+    clear = np.minimum(a[:, 2], b[:, 2]) - model.radius
+    body = ~model.is_foot
+    return float(clear[body].min()) if body.any() else math.inf
 
 
 def hip_to_hip_length(robot: Robot) -> float:
@@ -79,13 +100,15 @@ class CertificateConfig:
         position [m] (0.5 L): near a singular leg the obstacle step's
         Jacobians blow up and would fling the trunk away.
     clearance:
-        Least body clearance, feet excluded [m] (0.02 L [4 mm]). The SDF's
+        Least body clearance, feet excluded [m] (0.2 c0 [4 mm], with c0 the
+        body's clearance standing on flat ground, see
+        :func:`nominal_body_clearance`). The SDF's
         interpolation error bound is added on top of it, so the true
         clearance is at least this.
     clearance_overshoot:
         How far past ``clearance`` the obstacle correction aims [m].
     preferred_clearance:
-        Clearance below which the pose cost rises [m] (0.05 L [1 cm]).
+        Clearance below which the pose cost rises [m] (0.5 c0 [1 cm]).
     clearance_penalty:
         Pose cost at ``clearance``, falling linearly to 0 at ``preferred_clearance``.
     singularity_margin:
@@ -200,7 +223,8 @@ class FootstepConfig:
     cache_capacity:
         Certificate outcomes cached across plans and re-plans (about 40 bytes each).
     sdf_resolution:
-        Voxel size of the terrain's signed distance field [m] (L/40 [5 mm]).
+        Voxel size of the terrain's signed distance field [m] (the smaller of
+        L/40 and 0.3 c0 [5 mm]).
         Its interpolation error bound (0.87 × this) is added to the clearance.
     sdf_z_margin:
         Free space the SDF covers above the terrain [m] (1.4 × the nominal
@@ -310,6 +334,11 @@ class FootstepConfig:
                 "the footstep planner needs front hips ahead of hind hips"
             )
         half = 0.5 * length
+        # Clearances scale with how close the robot's own shins come to flat
+        # ground (c0), not with its length: ANYmal's shins sit 17 mm up, 3 % of L.
+        c0 = min(nominal_body_clearance(robot), 0.1 * length)
+        if not c0 > 0:
+            c0 = 0.1 * length
         cert_over = {
             k.removeprefix("certificate_"): v
             for k, v in overrides.items()
@@ -322,9 +351,9 @@ class FootstepConfig:
             "com_margin": 0.05 * length,
             "max_step": 0.1 * length,
             "max_drift": 0.5 * length,
-            "clearance": 0.02 * length,
-            "clearance_overshoot": 0.01 * length,
-            "preferred_clearance": 0.05 * length,
+            "clearance": 0.2 * c0,
+            "clearance_overshoot": 0.1 * c0,
+            "preferred_clearance": 0.5 * c0,
         }
         cert_names = {f.name for f in dataclasses.fields(CertificateConfig)}
         unknown_cert = sorted(set(cert_over) - cert_names)
@@ -350,7 +379,8 @@ class FootstepConfig:
             "certificate": certificate,
             "goal_radius": 0.25 * length,
             "turning_radius": length,
-            "sdf_resolution": length / 40,
+            # Its interpolation error (0.87 × this) stays below 0.26 c0.
+            "sdf_resolution": min(length / 40, 0.3 * c0),
             "sdf_z_margin": 1.4 * robot.nominal_stance.base_height,
         }
         defaults.update({k: v for k, v in overrides.items() if not k.startswith("certificate_")})

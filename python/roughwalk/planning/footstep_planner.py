@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from roughwalk import _core
-from roughwalk.errors import InvalidArgumentError, PlanningError
+from roughwalk.errors import InvalidArgumentError, PlanningError, TerrainError
 from roughwalk.planning.footstep_config import LEG_INDEX, FootstepConfig
 from roughwalk.planning.footstep_cost import FootholdCost, default_terrain_cost
 from roughwalk.planning.footstep_plan import (
@@ -88,13 +88,19 @@ class FootstepPlanner:
         self.sdf = sdf
         t1 = time.perf_counter()
         heading = self.config.cost_heading
-        self.cost_front = np.asarray(self.cost.cost_map(terrain, heading, "front"), dtype=float)
-        hind = getattr(self.cost, "separate_legs", True)
-        self.cost_hind = (
-            np.asarray(self.cost.cost_map(terrain, heading, "hind"), dtype=float)
-            if hind
-            else self.cost_front
-        )
+        try:
+            self.cost_front = np.asarray(self.cost.cost_map(terrain, heading, "front"), float)
+            hind = getattr(self.cost, "separate_legs", True)
+            self.cost_hind = (
+                np.asarray(self.cost.cost_map(terrain, heading, "hind"), float)
+                if hind
+                else self.cost_front
+            )
+        except TerrainError as e:
+            raise PlanningError(
+                f"the terrain cost cannot be evaluated on {terrain}: {e}. Pass a cost that "
+                "suits this grid (cost=..., or --cost FILE with features learned at larger radii)"
+            ) from None
         t2 = time.perf_counter()
         collision = CollisionModel.from_robot(robot)
         body = ~collision.is_foot
