@@ -125,6 +125,9 @@ def test_same_inputs_and_expansion_budget_give_the_same_plan(
         assert other.footsteps == rocks_plan.footsteps
         assert other.cost == rocks_plan.cost
         assert other.states_expanded == rocks_plan.states_expanded
+    # The search tree (each state once, from its first parent) does not depend on the cache.
+    np.testing.assert_array_equal(again.tree, fresh.tree)
+    assert 0 < len(fresh.tree) <= fresh.states_generated - 1
     # The warm cache served the repeat: fewer certificate searches, same plan.
     assert again.actions_evaluated < fresh.actions_evaluated
     assert again.certificate_cache_hits > fresh.certificate_cache_hits

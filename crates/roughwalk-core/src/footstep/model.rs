@@ -9,7 +9,7 @@
 //! and clearance penalties) and a per-step constant. An action without a
 //! pose certificate is pruned.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::hash::{BuildHasherDefault, Hasher};
 
 use crate::dubins::{dubins_heuristic, euclidean_heuristic};
@@ -147,6 +147,8 @@ pub struct FootstepModel {
     reach: [LegReach; 4],
     cache: HashMap<FootstepState, Outcome, BuildHasherDefault<FxHasher>>,
     tree: Vec<TreeEdge>,
+    /// States already drawn in `tree` (bounded by its cap).
+    tree_seen: HashSet<FootstepState, BuildHasherDefault<FxHasher>>,
     counters: ModelCounters,
     /// Terrain part of each successor's cost in the current expansion.
     terrain_parts: Vec<f64>,
@@ -224,6 +226,7 @@ impl FootstepModel {
             reach,
             cache: HashMap::default(),
             tree: Vec::new(),
+            tree_seen: HashSet::default(),
             counters: ModelCounters::default(),
             terrain_parts: Vec::new(),
             config,
@@ -283,6 +286,7 @@ impl FootstepModel {
 
     /// Returns and clears the recorded search-tree edges.
     pub fn take_tree(&mut self) -> Vec<TreeEdge> {
+        self.tree_seen = HashSet::default();
         std::mem::take(&mut self.tree)
     }
 
@@ -490,7 +494,9 @@ impl SearchProblem for FootstepProblem<'_> {
                 evaluated += 1;
             }
             let Ok(pose) = outcome else { continue };
-            if computed && model.tree.len() < model.config.max_tree_edges {
+            // Each state once, with the first parent that reached it: a tree,
+            // whether its certificate was computed now or cached.
+            if model.tree.len() < model.config.max_tree_edges && model.tree_seen.insert(child) {
                 model.tree.push(TreeEdge {
                     leg: leg as u8,
                     from: lattice.xy(s.feet[leg]),
