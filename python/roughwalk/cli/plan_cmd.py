@@ -20,8 +20,13 @@ def register(sub: Any) -> None:
     )
     p.add_argument("--robot", default="littledog", help="registered robot name (littledog)")
     p.add_argument("--terrain", required=True, help="a file, a generator spec or a course")
-    p.add_argument("--start", required=True, metavar="X,Y,YAW", help="trunk pose [m, m, rad]")
-    p.add_argument("--goal", required=True, metavar="X,Y", help="goal point [m]")
+    p.add_argument(
+        "--start",
+        required=True,
+        metavar="X,Y,YAW",
+        help="trunk pose [m, m, rad] (--start=-0.2,0.3,0 when X is negative)",
+    )
+    p.add_argument("--goal", required=True, metavar="X,Y", help="goal point [m] (--goal=-1,0)")
     p.add_argument(
         "--time-limit", type=float, default=5.0, metavar="S", help="planning budget [s] (5)"
     )
