@@ -17,8 +17,8 @@ from roughwalk.planning.footstep_planner import plan_footsteps
 from roughwalk.robots import Robot, load_robot
 from roughwalk.sim.run import run
 from roughwalk.terrain import Terrain, load_terrain
-from roughwalk.trajopt import optimize_motion
 from roughwalk.trajectories.api import footstep_trajectories
+from roughwalk.trajopt import optimize_motion
 
 __all__ = [
     "__version__",

@@ -147,9 +147,7 @@ def parse_set(items: Iterable[str]) -> dict[str, str]:
     return out
 
 
-def configure(
-    config: C, config_file: str | Path | None = None, sets: Iterable[str] = ()
-) -> C:
+def configure(config: C, config_file: str | Path | None = None, sets: Iterable[str] = ()) -> C:
     """Apply a TOML file and then ``--set`` overrides to ``config`` (later wins)."""
     if config_file is not None:
         config = override(config, load_toml(config_file))
