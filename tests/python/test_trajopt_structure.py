@@ -55,7 +55,7 @@ def test_variable_count_matches_melons_formula(flat: TerrainModel) -> None:
 
 def test_gaits_make_their_step_counts() -> None:
     assert valid_step_counts("walk", 4) == [4, 8, 12, 16]
-    assert valid_step_counts("trot", 4) == [2, 6, 10, 14]
+    assert valid_step_counts("trot", 8) == [2, 4, 6, 8, 10, 12, 14, 16]
     for gait in GAIT_NAMES:
         for steps in valid_step_counts(gait, 3):
             schedule = make_gait(gait, steps, 3.0)
@@ -66,6 +66,33 @@ def test_gaits_make_their_step_counts() -> None:
             # Every gait opens and closes with all four feet down.
             assert all(schedule.in_contact_at_start)
             assert all(schedule.in_contact(f, 3.0)[0] for f in range(4))
+
+
+def test_trot_makes_towrs_14_steps_and_any_even_count() -> None:
+    # TOWR's flying trot (0.4 s diagonal stance, 0.1 s flight) between 0.3 s
+    # stands, three strides and its end stride: 4.0 s, 14 steps; every
+    # phase scales with the duration.
+    towr = make_gait("trot", 14, 4.0)
+    assert towr.durations[0] == pytest.approx((0.7, 0.6, 0.4, 0.6, 0.4, 0.6, 0.7))
+    assert towr.durations[1] == pytest.approx((0.3, 0.5, 0.4, 0.6, 0.4, 0.6, 0.4, 0.5, 0.3))
+    assert make_gait("trot", 14, 3.5).durations[0] == pytest.approx(
+        [d * 3.5 / 4.0 for d in towr.durations[0]]
+    )
+    for steps in (2, 4, 8, 16):
+        schedule = make_gait("trot", steps, 4.6)
+        assert schedule.steps == steps
+        # Diagonal pairs (LF, RH) and (RF, LH) lift and land together.
+        assert schedule.durations[0] == schedule.durations[3]
+        assert schedule.durations[1] == schedule.durations[2]
+        assert all(schedule.in_contact(f, 4.6)[0] for f in range(4))
+        times = np.linspace(0.0, 4.6, 461)
+        # Never all four feet up for longer than the 0.1 s flight, never one foot alone.
+        stance = np.array([schedule.in_contact(f, times) for f in range(4)])
+        assert set(stance.sum(axis=0)) <= {0, 2, 4}
+    sixteen = make_gait("trot", 16, 4.6)
+    assert [sixteen.swing_count(f) for f in range(4)] == [4, 4, 4, 4]
+    assert sixteen.durations[0] == pytest.approx((0.7, 0.6, 0.4, 0.6, 0.4, 0.6, 0.4, 0.6, 0.3))
+    assert sixteen.durations[1] == pytest.approx((0.3, 0.5, 0.4, 0.6, 0.4, 0.6, 0.4, 0.6, 0.8))
 
 
 def test_bad_gaits_are_refused_by_name() -> None:

@@ -9,8 +9,12 @@ brings the feet back into a stand.
 
 A **step** is one foot's swing. The number of steps fixes how many strides
 are used; gaits whose stride count cannot give the requested steps are
-refused, naming the counts that work (the walk: 4, 8, 12, 16, ...; the trot:
-2, 6, 10, 14, ...).
+refused, naming the counts that work (the walk: 4, 8, 12, 16, ...). The
+two-beat gaits (trot, pace, bound) end either on their first support pair,
+as TOWR's end strides do (2, 6, 10, 14, ... steps), or after a whole stride
+without its last flight (4, 8, 12, 16, ...), so that they make any even
+count; the short ending is tried first, which keeps the counts TOWR makes
+exactly TOWR's schedules.
 
 Each foot's schedule is then its alternating stance and swing phase durations
 [s], scaled so that the whole motion lasts the requested duration.
@@ -92,13 +96,14 @@ def _drop_transition(stride: list[Phase]) -> list[Phase]:
     return [*body[:-1], (last_time + stride[-1][0], last_state)]
 
 
-# The end stride of each gait: it lands every foot so that the final stand can follow.
-_END_STRIDES: dict[str, list[Phase]] = {
-    "walk": _drop_transition(_STRIDES["walk"]),
-    "trot": [(0.4, (1, 0, 0, 1))],
-    "pace": [(0.3, (1, 0, 1, 0))],
-    "bound": [(0.3, (0, 0, 1, 1))],
-    "gallop": _drop_transition(_STRIDES["gallop"]),
+# The end strides of each gait, tried in this order: each lands every foot so
+# that the final stand can follow. TOWR's own end stride comes first.
+_END_STRIDES: dict[str, list[list[Phase]]] = {
+    "walk": [_drop_transition(_STRIDES["walk"])],
+    "trot": [[(0.4, (1, 0, 0, 1))], _drop_transition(_STRIDES["trot"])],
+    "pace": [[(0.3, (1, 0, 1, 0))], _drop_transition(_STRIDES["pace"])],
+    "bound": [[(0.3, (0, 0, 1, 1))], _drop_transition(_STRIDES["bound"])],
+    "gallop": [_drop_transition(_STRIDES["gallop"])],
 }
 
 _STAND_TIME = 0.3  # [s], TOWR's stand phase
@@ -205,15 +210,20 @@ def _schedule(name: str, phases: Sequence[Phase]) -> ContactSchedule:
     return ContactSchedule(name, tuple(tuple(d) for d in durations), first)
 
 
-def _gait_phases(name: str, strides: int) -> list[Phase]:
-    body = _STRIDES[name] * (strides - 1) + _END_STRIDES[name]
-    return [(_STAND_TIME, _STAND), *body, (_STAND_TIME, _STAND)]
+def _gait_schedules(name: str, strides: int) -> list[ContactSchedule]:
+    """The schedules of ``strides`` strides (the last one an end stride), one per end stride."""
+    return [
+        _schedule(name, [(_STAND_TIME, _STAND), *_STRIDES[name] * (strides - 1), *end,
+                         (_STAND_TIME, _STAND)])
+        for end in _END_STRIDES[name]
+    ]  # fmt: skip
 
 
 def valid_step_counts(gait: str, limit: int = 6) -> list[int]:
-    """The first ``limit`` step counts that ``gait`` can make."""
+    """The first ``limit`` step counts that ``gait`` can make, in increasing order."""
     _check_gait(gait)
-    return [_schedule(gait, _gait_phases(gait, n)).steps for n in range(1, limit + 1)]
+    counts = {s.steps for n in range(1, limit + 1) for s in _gait_schedules(gait, n)}
+    return sorted(counts)[:limit]
 
 
 def _check_gait(gait: str) -> None:
@@ -235,10 +245,11 @@ def make_gait(gait: str, steps: int, duration: float) -> ContactSchedule:
     if isinstance(steps, bool) or not isinstance(steps, int | np.integer) or steps < 1:
         raise InvalidArgumentError(f"steps must be a positive integer, got {steps!r}")
     for strides in range(1, _MAX_STRIDES + 1):
-        schedule = _schedule(gait, _gait_phases(gait, strides))
-        if schedule.steps == steps:
-            return schedule.scaled(float(duration))
-        if schedule.steps > steps:
+        schedules = _gait_schedules(gait, strides)
+        for schedule in schedules:
+            if schedule.steps == steps:
+                return schedule.scaled(float(duration))
+        if min(s.steps for s in schedules) > steps:
             break
     counts = ", ".join(str(c) for c in valid_step_counts(gait))
     raise InvalidArgumentError(
