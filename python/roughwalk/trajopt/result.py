@@ -282,6 +282,99 @@ class TrajoptResult:
             out["trajectory"] = {k: v.tolist() for k, v in samples.items()}
         return out
 
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> TrajoptResult:
+        """The result written by :meth:`to_dict` (or ``roughwalk optimize --json``), splines exact.
+
+        Samples are not read back: the spline nodes are the motion. Solver
+        multipliers and the solution vector are not in the JSON and stay None.
+        """
+
+        def spline(d: dict[str, Any]) -> NumericSpline:
+            return NumericSpline(d["positions"], d["velocities"], d["durations"])
+
+        try:
+            nodes = data.get("nodes")
+            splines = (
+                Splines(
+                    spline(nodes["base_linear"]),
+                    spline(nodes["base_angular"]),
+                    [spline(f) for f in nodes["feet"]],
+                    [spline(f) for f in nodes["forces"]],
+                )
+                if nodes
+                else None
+            )
+            body = data.get("body")
+            schedule = (
+                ContactSchedule(
+                    str(data.get("gait", "")),
+                    tuple(tuple(float(v) for v in foot) for foot in data["phase_durations"]),
+                    tuple(bool(c) for c in data["in_contact_at_start"]),
+                )
+                if "phase_durations" in data
+                else None
+            )
+            return cls(
+                status=TrajoptStatus(data["status"]),
+                message=str(data.get("message", "")),
+                iterations=int(data.get("iterations", 0)),
+                solve_time_s=float(data.get("solve_time_s", 0.0)),
+                build_time_s=float(data.get("build_time_s", 0.0)),
+                objective=float(data.get("objective") or math.nan),
+                max_violation=float(data.get("max_violation") or 0.0),
+                max_force_n=float(data.get("max_force_n") or math.nan),
+                n_variables=int(data.get("n_variables", 0)),
+                n_constraints=int(data.get("n_constraints", 0)),
+                task=Task.from_any(data["task"]) if data.get("task") else None,
+                config=dict(data.get("config", {})),
+                body=SingleRigidBody(
+                    name=body["name"],
+                    mass=float(body["mass"]),
+                    inertia=tuple(tuple(r) for r in body["inertia"]),  # type: ignore[arg-type]
+                    nominal_stance=tuple(tuple(r) for r in body["nominal_stance"]),  # type: ignore[arg-type]
+                    max_deviation=tuple(body["max_deviation"]),
+                    force_limit=float(body["force_limit"]),
+                    friction=float(body["friction"]),
+                    com_in_base=tuple(body.get("com_in_base", (0.0, 0.0, 0.0))),
+                )
+                if body
+                else None,
+                schedule=schedule,
+                splines=splines,
+                costs={
+                    k: float(v) if v is not None else math.nan
+                    for k, v in data.get("costs", {}).items()
+                },
+                violations={
+                    k: float(v) if v is not None else math.nan
+                    for k, v in data.get("violations", {}).items()
+                },
+                return_status=str(data.get("return_status", "")),
+                history=list(data.get("history", [])),
+                robot=data.get("robot"),
+                terrain=data.get("terrain"),
+            )
+        except (KeyError, TypeError, ValueError) as e:
+            raise PlanningError(
+                f"not a trajopt result (roughwalk optimize --json): {type(e).__name__} {e}"
+            ) from None
+
+    @classmethod
+    def load(cls, path: str | Path) -> TrajoptResult:
+        """Read a result JSON written by ``roughwalk optimize --json`` [file path]."""
+        import json
+
+        try:
+            data = json.loads(Path(path).read_text())
+        except (OSError, ValueError) as e:
+            raise PlanningError(f"cannot read trajectory file '{path}': {e}") from None
+        if not isinstance(data, dict) or data.get("schema", RESULT_SCHEMA) != RESULT_SCHEMA:
+            raise PlanningError(
+                f"'{path}' is not a {RESULT_SCHEMA} JSON (roughwalk optimize --json writes one)"
+            )
+        return cls.from_dict(data)
+
     def __repr__(self) -> str:
         return (
             f"TrajoptResult({self.status.value}, {self.iterations} iterations, "

@@ -1,0 +1,36 @@
+"""Whole-body tracking of optimised motions in MuJoCo (Melon et al. 2020, §V).
+
+Start with :func:`track`: it executes a :class:`~roughwalk.trajopt.TrajoptResult`
+(or the JSON ``roughwalk optimize --json`` writes) on the robot in physics
+with a 400 Hz whole-body QP controller and says whether the motion was
+trackable (:class:`TrackingOutcome`).
+"""
+
+from roughwalk.tracking.config import (
+    ContactStateConfig,
+    TaskWeights,
+    TrackingConfig,
+    TrackingGains,
+)
+from roughwalk.tracking.contact_state import ContactEstimate, ContactStateMachine, LegContact
+from roughwalk.tracking.reference import Reference, ReferenceSample, load_trajectory
+from roughwalk.tracking.tasks import LeastSquaresTask, QPLayout
+from roughwalk.tracking.whole_body_qp import QPSolution, WholeBodyQP, friction_pyramid
+
+__all__ = [
+    "TrackingConfig",
+    "TrackingGains",
+    "TaskWeights",
+    "ContactStateConfig",
+    "ContactStateMachine",
+    "ContactEstimate",
+    "LegContact",
+    "Reference",
+    "ReferenceSample",
+    "load_trajectory",
+    "LeastSquaresTask",
+    "QPLayout",
+    "WholeBodyQP",
+    "QPSolution",
+    "friction_pyramid",
+]

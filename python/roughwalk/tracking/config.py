@@ -1,0 +1,178 @@
+"""Settings of the whole-body tracking controller, with units and what each trades off.
+
+Override any field by dotted key: ``roughwalk.track(..., **{"gains.base_kp": 150})``
+or ``roughwalk track --set gains.base_kp=150``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from roughwalk.errors import ConfigError
+
+__all__ = ["TrackingConfig", "TrackingGains", "TaskWeights", "ContactStateConfig"]
+
+
+def _positive(obj: object, names: tuple[str, ...], prefix: str) -> None:
+    for name in names:
+        v = getattr(obj, name)
+        if not (isinstance(v, int | float) and math.isfinite(v) and v > 0):
+            raise ConfigError(f"{prefix}.{name} must be a positive number, got {v!r}")
+
+
+@dataclass(frozen=True)
+class TrackingGains:
+    """PD gains of the task-space accelerations (Bellicoso et al. 2016 style).
+
+    Attributes
+    ----------
+    base_kp, base_kd:
+        Base position feedback [1/s²] and [1/s]: a 10 rad/s natural
+        frequency (100, 20) corrects centimetre errors within a step without
+        fighting the planned accelerations.
+    orientation_kp, orientation_kd:
+        Base orientation feedback [1/s²], [1/s].
+    swing_kp, swing_kd:
+        Swing-foot feedback [1/s²], [1/s]: stiffer than the base, a swing leg
+        is light and must land where planned.
+    slip_gain_scale:
+        Factor on the stance-foot weight and on the base gains while a foot
+        slips: holding the foot harder is what stops a slip.
+    """
+
+    base_kp: float = 100.0
+    base_kd: float = 20.0
+    orientation_kp: float = 100.0
+    orientation_kd: float = 20.0
+    swing_kp: float = 400.0
+    swing_kd: float = 40.0
+    slip_gain_scale: float = 3.0
+
+    def __post_init__(self) -> None:
+        _positive(self, tuple(self.__dataclass_fields__), "gains")
+
+
+@dataclass(frozen=True)
+class TaskWeights:
+    """Weights of the QP's least-squares tasks (each task's residual is in m/s², rad/s² or N).
+
+    Attributes
+    ----------
+    base_linear, base_angular:
+        Base acceleration tasks.
+    swing_foot:
+        Swing-foot acceleration task.
+    stance_foot:
+        Stance feet do not accelerate (J q̈ + J̇ q̇ = 0); heavy, a soft contact constraint.
+    force:
+        Contact force tracking [1/N²]: the planned forces are a preference, the
+        base tasks decide.
+    joint_acceleration, torque:
+        Regularisation of q̈ [1/(rad/s²)²] and τ [1/(N·m)²] that keeps the QP strictly convex.
+    """
+
+    base_linear: float = 1.0
+    base_angular: float = 1.0
+    swing_foot: float = 1.0
+    stance_foot: float = 100.0
+    force: float = 1e-4
+    joint_acceleration: float = 1e-4
+    torque: float = 1e-6
+
+    def __post_init__(self) -> None:
+        _positive(self, tuple(self.__dataclass_fields__), "weights")
+
+
+@dataclass(frozen=True)
+class ContactStateConfig:
+    """When a foot counts as touching, early, late or slipping.
+
+    Attributes
+    ----------
+    contact_force_n:
+        A foot touches when its measured normal force exceeds this [N].
+    early_touchdown_phase:
+        A swing foot that touches after this fraction of its swing is treated
+        as in stance (an early touchdown); before it, the touch is a scuff.
+    search_speed_m_s:
+        A foot planned in stance but not touching (a late touchdown) keeps
+        moving down at this speed [m/s] until it finds the ground.
+    search_depth_m:
+        It stops reaching down this far [m] below the planned foothold.
+    slip_speed_m_s:
+        A stance foot moving faster than this [m/s] slips.
+    """
+
+    contact_force_n: float = 5.0
+    early_touchdown_phase: float = 0.5
+    search_speed_m_s: float = 0.3
+    search_depth_m: float = 0.1
+    slip_speed_m_s: float = 0.1
+
+    def __post_init__(self) -> None:
+        _positive(self, tuple(self.__dataclass_fields__), "contact")
+
+
+@dataclass(frozen=True)
+class TrackingConfig:
+    """Everything :func:`roughwalk.track` takes; see each part's documentation.
+
+    Attributes
+    ----------
+    control_hz:
+        Controller rate [Hz]; the paper's controller runs at 400 Hz.
+    physics_hz:
+        Physics rate [Hz], an integer multiple of ``control_hz``.
+    stand_after_s:
+        Time [s] the robot keeps standing at the final pose after the motion.
+    max_roll_pitch_rad:
+        Roll or pitch beyond this [rad] is a fall (45°).
+    final_position_tolerance_m:
+        Success needs the base this close [m] to the planned final position.
+    friction:
+        Friction coefficient μ of the QP's pyramids (below the simulated
+        ground's, so planned forces do not slide).
+    min_normal_force_n, max_normal_force_n:
+        Bounds [N] on a stance foot's normal force.
+    qp_solver:
+        qpsolvers' name of the QP solver ("proxqp", "osqp", ...).
+    """
+
+    control_hz: float = 400.0
+    physics_hz: float = 2000.0
+    stand_after_s: float = 1.0
+    max_roll_pitch_rad: float = math.pi / 4
+    final_position_tolerance_m: float = 0.10
+    friction: float = 0.6
+    min_normal_force_n: float = 2.0
+    max_normal_force_n: float = 1500.0
+    qp_solver: str = "proxqp"
+    gains: TrackingGains = field(default_factory=TrackingGains)
+    weights: TaskWeights = field(default_factory=TaskWeights)
+    contact: ContactStateConfig = field(default_factory=ContactStateConfig)
+
+    def __post_init__(self) -> None:
+        _positive(
+            self,
+            (
+                "control_hz",
+                "physics_hz",
+                "max_roll_pitch_rad",
+                "final_position_tolerance_m",
+                "friction",
+                "max_normal_force_n",
+            ),
+            "tracking",
+        )
+        if not (self.stand_after_s >= 0 and self.min_normal_force_n >= 0):
+            raise ConfigError(
+                "tracking.stand_after_s and tracking.min_normal_force_n must be ≥ 0, got "
+                f"{self.stand_after_s}, {self.min_normal_force_n}"
+            )
+        ratio = self.physics_hz / self.control_hz
+        if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
+            raise ConfigError(
+                f"tracking.physics_hz ({self.physics_hz}) must be an integer multiple of "
+                f"tracking.control_hz ({self.control_hz})"
+            )

@@ -1,0 +1,202 @@
+"""The whole-body QP: joint accelerations, torques and contact forces in one solve.
+
+Unknowns x = [q̈, τ, f] (:class:`~roughwalk.tracking.tasks.QPLayout`). Hard
+constraints: the floating-base equations of motion M q̈ + h = Sᵀτ + J_cᵀ f
+(all nv rows, so τ is exactly what the actuators must produce), a friction
+pyramid and normal-force bounds per stance foot, and the actuators' torque
+limits. The objective is a weighted sum of least-squares tasks (base pose,
+swing feet, stance feet, planned forces, regularisation), in the spirit of
+Bellicoso et al. 2016's whole-body controller that Melon et al. 2020 §V ran
+their trajectories on (weighted instead of strictly prioritised: one QP per
+tick instead of one per priority level).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from roughwalk.errors import ConfigError
+from roughwalk.tracking.tasks import LeastSquaresTask, QPLayout
+
+__all__ = ["WholeBodyQP", "QPSolution", "friction_pyramid"]
+
+
+@dataclass(frozen=True)
+class QPSolution:
+    """One solve of the whole-body QP.
+
+    Attributes
+    ----------
+    success:
+        The solver returned a solution (False: the other fields are zeros).
+    qacc:
+        (nv,) generalised accelerations q̈.
+    tau:
+        (nu,) joint torques τ [N·m].
+    forces:
+        (n_contacts, 3) contact forces on the stance feet [N], world axes.
+    x:
+        The solution vector [q̈, τ, f].
+    """
+
+    success: bool
+    qacc: NDArray[np.float64]
+    tau: NDArray[np.float64]
+    forces: NDArray[np.float64]
+    x: NDArray[np.float64]
+
+
+def friction_pyramid(normal: ArrayLike, friction: float) -> NDArray[np.float64]:
+    """(4, 3) rows C with C f ≤ 0 ⇔ f inside the 4-sided pyramid of ``normal`` and μ."""
+    n = np.asarray(normal, dtype=float)
+    n = n / np.linalg.norm(n)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    t1 = np.cross(n, helper)
+    t1 /= np.linalg.norm(t1)
+    t2 = np.cross(n, t1)
+    return np.array([t1 - friction * n, -t1 - friction * n, t2 - friction * n, -t2 - friction * n])
+
+
+class WholeBodyQP:
+    """Build and solve the whole-body QP with a qpsolvers backend.
+
+    Parameters
+    ----------
+    actuated_dofs:
+        (nu,) indices of the actuated joints' degrees of freedom in q̇ (S's columns).
+    torque_limit:
+        (nu,) |τ| bound [N·m] per actuated joint.
+    friction:
+        Friction coefficient μ of the pyramids (keep it under the ground's).
+    min_normal_force, max_normal_force:
+        Bounds [N] of each stance foot's normal force.
+    solver:
+        qpsolvers' solver name ("proxqp", "osqp", ...).
+    """
+
+    def __init__(
+        self,
+        actuated_dofs: ArrayLike,
+        torque_limit: ArrayLike,
+        friction: float,
+        min_normal_force: float = 0.0,
+        max_normal_force: float = np.inf,
+        solver: str = "proxqp",
+    ) -> None:
+        import qpsolvers
+
+        if solver not in qpsolvers.available_solvers:
+            raise ConfigError(
+                f"QP solver '{solver}' is not installed; available: "
+                f"{', '.join(qpsolvers.available_solvers) or 'none'} (pip install proxsuite)"
+            )
+        self.actuated_dofs = np.asarray(actuated_dofs, dtype=np.int64)
+        self.torque_limit = np.asarray(torque_limit, dtype=float)
+        if self.torque_limit.shape != self.actuated_dofs.shape:
+            raise ConfigError(
+                f"torque_limit has {self.torque_limit.shape}, actuated_dofs "
+                f"{self.actuated_dofs.shape}: one limit per actuated joint"
+            )
+        self.friction = float(friction)
+        self.min_normal_force = float(min_normal_force)
+        self.max_normal_force = float(max_normal_force)
+        self.solver = solver
+        self._solve_qp = qpsolvers.solve_qp
+
+    def layout(self, nv: int, n_contacts: int) -> QPLayout:
+        """The unknowns' layout for a model of ``nv`` DoF with ``n_contacts`` stance feet."""
+        return QPLayout(nv, len(self.actuated_dofs), n_contacts)
+
+    def solve(
+        self,
+        mass_matrix: ArrayLike,
+        bias: ArrayLike,
+        contact_jacobian: ArrayLike,
+        tasks: Sequence[LeastSquaresTask],
+        normals: ArrayLike | None = None,
+    ) -> QPSolution:
+        """Minimise Σ w‖A x − b‖² subject to dynamics, friction and torque limits.
+
+        Parameters
+        ----------
+        mass_matrix:
+            (nv, nv) M(q) (MuJoCo's ``mj_fullM``).
+        bias:
+            (nv,) h = C(q, q̇) q̇ + g(q) − passive forces (``qfrc_bias − qfrc_passive``).
+        contact_jacobian:
+            (3·nc, nv) stacked translational Jacobians of the stance feet.
+        tasks:
+            The objective's tasks, all over this layout.
+        normals:
+            (nc, 3) terrain normals at the stance feet (default: z up).
+        """
+        m = np.asarray(mass_matrix, dtype=float)
+        h = np.asarray(bias, dtype=float)
+        nv = m.shape[0]
+        jc = np.asarray(contact_jacobian, dtype=float).reshape(-1, nv)
+        nc = jc.shape[0] // 3
+        lay = self.layout(nv, nc)
+        n = lay.size
+        nrm = np.tile([0.0, 0.0, 1.0], (nc, 1)) if normals is None else np.asarray(normals)
+
+        # M q̈ − Sᵀτ − J_cᵀ f = −h
+        a_eq = np.zeros((nv, n))
+        a_eq[:, lay.qacc] = m
+        a_eq[self.actuated_dofs, lay.tau] = -np.eye(lay.nu)
+        a_eq[:, nv + lay.nu :] = -jc.T
+        b_eq = -h
+
+        g_rows: list[NDArray[np.float64]] = []
+        h_rows: list[NDArray[np.float64]] = []
+        t_rows = np.zeros((2 * lay.nu, n))
+        t_rows[: lay.nu, lay.tau] = np.eye(lay.nu)
+        t_rows[lay.nu :, lay.tau] = -np.eye(lay.nu)
+        g_rows.append(t_rows)
+        h_rows.append(np.concatenate([self.torque_limit, self.torque_limit]))
+        for i in range(nc):
+            normal = nrm[i] / np.linalg.norm(nrm[i])
+            rows = np.zeros((6, n))
+            rows[:4, lay.force(i)] = friction_pyramid(normal, self.friction)
+            rows[4, lay.force(i)] = -normal
+            rows[5, lay.force(i)] = normal
+            g_rows.append(rows)
+            h_rows.append(
+                np.array([0.0, 0.0, 0.0, 0.0, -self.min_normal_force, self.max_normal_force])
+            )
+        g = np.vstack(g_rows)
+        g_h = np.concatenate(h_rows)
+        if not np.isfinite(self.max_normal_force):
+            keep = np.isfinite(g_h)
+            g, g_h = g[keep], g_h[keep]
+
+        p = np.zeros((n, n))
+        q = np.zeros(n)
+        for task in tasks:
+            aw = task.weight * task.matrix
+            p += aw.T @ task.matrix
+            q -= aw.T @ task.target
+        p = 0.5 * (p + p.T) + 1e-9 * np.eye(n)
+        x = self._solve_qp(
+            p, q, G=g, h=g_h, A=a_eq, b=b_eq, solver=self.solver, **_solver_options(self.solver)
+        )
+        if x is None or not np.all(np.isfinite(x)):
+            zero = np.zeros(n)
+            return QPSolution(False, zero[lay.qacc], zero[lay.tau], np.zeros((nc, 3)), zero)
+        x = np.asarray(x, dtype=float)
+        forces = x[nv + lay.nu :].reshape(nc, 3)
+        return QPSolution(True, x[lay.qacc].copy(), x[lay.tau].copy(), forces.copy(), x)
+
+
+def _solver_options(solver: str) -> dict[str, Any]:
+    # Tight tolerances: the torques are applied as solved, and a loose
+    # equality would be a force error the base feels.
+    if solver == "proxqp":
+        return {"eps_abs": 1e-8, "eps_rel": 0.0}
+    if solver == "osqp":
+        return {"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iter": 20000, "polish": True}
+    return {}
