@@ -324,3 +324,71 @@ class FootstepPlanner:
     @property
     def cache_len(self) -> int:
         """Cached certificate outcomes."""
+
+class BodyPassEvaluator:
+    """The trunk block of one footstep's CHOMP (Zucker 2011, §5.3), evaluated in one call."""
+
+    def __init__(
+        self,
+        quadruped: Quadruped,
+        sdf: SdfField,
+        point_leg: ArrayLike,
+        point_link: ArrayLike,
+        point_local: ArrayLike,
+        point_radius: ArrayLike,
+        point_is_foot: ArrayLike,
+        body: ArrayLike,
+        feet: ArrayLike,
+        support: ArrayLike,
+        held_q: ArrayLike,
+        active: ArrayLike,
+        hips: ArrayLike,
+        max_reach: ArrayLike,
+        velocity_limit: ArrayLike,
+        polygons: list[ArrayLike],
+        polygon_index: ArrayLike,
+        com_offset: ArrayLike,
+        com_offset_acceleration: ArrayLike,
+        *,
+        dt: float,
+        reach_margin: float,
+        reach_weight: float,
+        damping: float,
+        zmp_k: float,
+        zmp_margin: float,
+        support_weight: float,
+        obstacle_epsilon: float,
+        obstacle_weight: float,
+        gradient: str,
+    ) -> None: ...
+    def evaluate(self, xi: ArrayLike) -> dict[str, Any]:
+        """Terms, gradient (n, 6), clearances, points, q, reached, ZMP margins at ξ (n, 6)."""
+
+class SwingPassEvaluator:
+    """The swing-leg block of one footstep's CHOMP (Zucker 2011, §5.3), evaluated in one call."""
+
+    def __init__(
+        self,
+        quadruped: Quadruped,
+        sdf: SdfField,
+        point_leg: ArrayLike,
+        point_link: ArrayLike,
+        point_local: ArrayLike,
+        point_radius: ArrayLike,
+        point_is_foot: ArrayLike,
+        leg: int,
+        base_pos: ArrayLike,
+        rotation: ArrayLike,
+        ends: ArrayLike,
+        active: ArrayLike,
+        velocity_limit: ArrayLike,
+        *,
+        dt: float,
+        speed_fraction: float,
+        speed_weight: float,
+        obstacle_epsilon: float,
+        obstacle_weight: float,
+        gradient: str,
+    ) -> None: ...
+    def evaluate(self, xi: ArrayLike) -> dict[str, Any]:
+        """Terms, gradient (n, 3), the leg's clearances and points at ξ (n, 3) [rad]."""

@@ -11,6 +11,7 @@ pub mod heightfield;
 pub mod kinematics;
 pub mod sdf;
 pub mod search;
+pub mod trajectory;
 
 pub use error::{CoreError, CoreResult};
 pub use heightfield::{HeightField, Interpolation};

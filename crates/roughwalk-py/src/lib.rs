@@ -14,6 +14,7 @@ mod footstep;
 mod heightfield;
 mod robot;
 mod sdf;
+mod trajectory;
 
 /// The compiled module `roughwalk._core`.
 #[pymodule]
@@ -23,5 +24,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     sdf::register(m)?;
     robot::register(m)?;
     footstep::register(m)?;
+    trajectory::register(m)?;
     Ok(())
 }

@@ -217,7 +217,7 @@ impl PySdfBand {
 /// height-field fall-back outside the lattice.
 #[pyclass(name = "SdfField", module = "roughwalk._core", frozen)]
 pub struct PySdfField {
-    inner: SignedDistanceField,
+    pub(crate) inner: SignedDistanceField,
 }
 
 #[pymethods]

@@ -6,13 +6,23 @@ at the interior samples; the supporting legs follow by IK, the lifted leg
 keeps its joint angles. The objective gathers the smoothness of the change,
 the obstacle cost of every body point (supporting feet excepted),
 reachability of the supporting feet and the ZMP support margin.
+
+Two backends evaluate the same terms: ``"rust"`` (the core's
+``BodyPassEvaluator``: IK, body points, SDF, every term and its gradient in
+one call per evaluation) and ``"python"`` (numpy over the batched
+kinematics of :class:`WholeBody`; the reference the Rust one is tested
+against). ``"auto"`` takes Rust whenever the SDF is the compiled one.
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import NDArray
 
+from roughwalk import _core
+from roughwalk.errors import InvalidArgumentError
 from roughwalk.trajectories.chomp import Evaluation
 from roughwalk.trajectories.config import ChompConfig, ValidityConfig
 from roughwalk.trajectories.costs.obstacle import ObstacleCost
@@ -23,12 +33,51 @@ from roughwalk.trajectories.euler import rpy_rate_matrix, rpy_to_matrix
 from roughwalk.trajectories.initial_trajectory import FootstepState
 from roughwalk.trajectories.whole_body import WholeBody
 
-__all__ = ["BodyPass", "clearance_ok", "velocity_ok", "velocity_excess"]
+__all__ = [
+    "BACKENDS",
+    "BodyPass",
+    "clearance_ok",
+    "compiled_field",
+    "resolve_backend",
+    "velocity_ok",
+    "velocity_excess",
+]
 
 # The ZMP here comes from CHOMP's samples; the check at the control rate
 # differentiates a spline through them and lands up to about a millimetre
 # elsewhere, so CHOMP stops only with that much to spare [m].
 _ZMP_GUARD = 0.001
+
+# μ of the damped J_fB⁻¹ in the trunk pass's point Jacobians [m/rad].
+_DAMPING = 1e-3
+
+BACKENDS = ("auto", "rust", "python")
+
+
+def compiled_field(sdf: Any) -> _core.SdfField | None:
+    """The Rust core's field behind a :class:`~roughwalk.terrain.SignedDistanceField`, if any."""
+    # The terrain wing keeps its compiled field private; reading it here spares
+    # a copy of the voxels per pass, and duck-typed test fields simply have none.
+    core = getattr(sdf, "_core", None)
+    return core if isinstance(core, _core.SdfField) else None
+
+
+def resolve_backend(backend: str, sdf: Any) -> str:
+    """``"rust"`` or ``"python"`` for a requested backend and a field."""
+    if backend not in BACKENDS:
+        raise InvalidArgumentError(
+            f"unknown CHOMP pass backend {backend!r}; known: {', '.join(BACKENDS)}"
+        )
+    if backend == "python":
+        return backend
+    if compiled_field(sdf) is None:
+        if backend == "rust":
+            raise InvalidArgumentError(
+                "the rust backend needs a compiled SignedDistanceField, "
+                f"got {type(sdf).__name__}; use backend='python'"
+            )
+        return "python"
+    return "rust"
 
 
 def clearance_ok(
@@ -81,6 +130,8 @@ class BodyPass:
     reference:
         The interior trunk path (n, 6) whose changes the smoothness term
         penalises (default: the state's current one).
+    backend:
+        ``"auto"``, ``"rust"`` or ``"python"`` (module docstring).
     """
 
     def __init__(
@@ -92,6 +143,7 @@ class BodyPass:
         validity: ValidityConfig,
         gravity: float = 9.81,
         reference: NDArray[np.float64] | None = None,
+        backend: str = "auto",
     ) -> None:
         self.wb = wb
         self.state = state
@@ -132,6 +184,41 @@ class BodyPass:
         self.held_q = state.q.copy()
         self.footholds = np.array([state.step.start, state.step.target])
         self.hips = wb.robot.hip_positions
+        self.backend = resolve_backend(backend, obstacle.sdf)
+        self._rust: _core.BodyPassEvaluator | None = None
+        field = compiled_field(obstacle.sdf)
+        if field is not None and self.backend == "rust":
+            self._rust = _core.BodyPassEvaluator(
+                wb.core,
+                field,
+                pts.leg,
+                pts.link,
+                pts.local,
+                pts.radius,
+                pts.is_foot,
+                state.body,
+                state.feet,
+                state.support,
+                self.held_q,
+                self.active,
+                self.hips,
+                wb.max_reach,
+                wb.velocity_limit,
+                [np.asarray(p, dtype=float)[:, :2] for p in state.polygons],
+                state.polygon_index,
+                state.com_offset[:, :2],
+                state.com_offset_acceleration[:, :2],
+                dt=state.dt,
+                reach_margin=config.reach_margin,
+                reach_weight=config.reachability_weight * self.h,
+                damping=_DAMPING,
+                zmp_k=state.com_height / gravity,
+                zmp_margin=config.zmp_margin,
+                support_weight=config.support_weight * self.h,
+                obstacle_epsilon=obstacle.epsilon,
+                obstacle_weight=obstacle.weight,
+                gradient=obstacle.mode,
+            )
 
     def configure(
         self, xi: NDArray[np.float64]
@@ -178,6 +265,49 @@ class BodyPass:
 
     def evaluate(self, xi: NDArray[np.float64]) -> Evaluation:
         """Obstacle + reachability + support terms and their gradient (n, 6) at ξ."""
+        if self._rust is not None:
+            return self._evaluate_rust(xi)
+        return self.evaluate_python(xi)
+
+    def _feasible(
+        self,
+        lost: float,
+        excess: float,
+        clearance: NDArray[np.float64],
+        points: NDArray[np.float64],
+        margins: NDArray[np.float64],
+    ) -> bool:
+        return (
+            lost == 0
+            and excess == 0.0
+            and clearance_ok(
+                clearance,
+                self.active,
+                points,
+                self.wb.points.is_foot,
+                self.footholds,
+                self.validity,
+                self.state.contact_clearance,
+            )
+            and bool(np.all(margins >= _ZMP_GUARD - self.validity.zmp_tolerance))
+        )
+
+    def _evaluate_rust(self, xi: NDArray[np.float64]) -> Evaluation:
+        assert self._rust is not None
+        r = self._rust.evaluate(np.ascontiguousarray(xi, dtype=float))
+        lost = float(np.sum(~r["reached"]))
+        excess = float(r["velocity_excess"])
+        parts = {k: float(r[k]) for k in ("obstacle", "reachability", "support")}
+        return Evaluation(
+            value=parts["obstacle"] + parts["reachability"] + parts["support"],
+            gradient=r["gradient"],
+            parts=parts,
+            feasible=self._feasible(lost, excess, r["clearance"], r["points"], r["margins"]),
+            violation=lost + excess,
+        )
+
+    def evaluate_python(self, xi: NDArray[np.float64]) -> Evaluation:
+        """:meth:`evaluate` in numpy: the reference of the Rust evaluation."""
         s = self.state
         wb = self.wb
         body, rot, q, reached = self.configure(xi)
@@ -207,20 +337,7 @@ class BodyPass:
         grad[:, :2] += sup_grad
         excess = velocity_excess(q, s.dt, self.wb.velocity_limit)
         lost = float(np.sum(~reached))
-        feasible = (
-            lost == 0
-            and excess == 0.0
-            and clearance_ok(
-                obs.clearance,
-                self.active,
-                points,
-                self.wb.points.is_foot,
-                self.footholds,
-                self.validity,
-                s.contact_clearance,
-            )
-            and bool(np.all(margins >= _ZMP_GUARD - self.validity.zmp_tolerance))
-        )
+        feasible = self._feasible(lost, excess, obs.clearance, points, margins)
         return Evaluation(
             value=obs.value + reach_value + sup_value,
             gradient=grad,

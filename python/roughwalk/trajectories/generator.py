@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 
 from roughwalk.errors import InvalidArgumentError
 from roughwalk.trajectories.body_keyframes import BodyKeyframe, keyframe_at
-from roughwalk.trajectories.body_pass import BodyPass
+from roughwalk.trajectories.body_pass import BACKENDS, BodyPass
 from roughwalk.trajectories.chomp import Chomp, ChompStatus
 from roughwalk.trajectories.config import TrajectoryConfig
 from roughwalk.trajectories.costs.obstacle import ObstacleCost
@@ -91,6 +91,9 @@ class FootstepTrajectoryGenerator:
         A prebuilt :class:`~roughwalk.terrain.SignedDistanceField` of ``terrain``.
     config:
         Settings (default :class:`TrajectoryConfig`).
+    backend:
+        Who evaluates CHOMP's passes: ``"auto"`` (the Rust core whenever the
+        SDF is the compiled one), ``"rust"`` or ``"python"`` (the numpy reference).
     """
 
     def __init__(
@@ -100,6 +103,7 @@ class FootstepTrajectoryGenerator:
         *,
         sdf: Any = None,
         config: TrajectoryConfig | None = None,
+        backend: str = "auto",
     ) -> None:
         self.config = config if config is not None else TrajectoryConfig()
         if sdf is None and terrain is None:
@@ -109,6 +113,11 @@ class FootstepTrajectoryGenerator:
         self._sdf = sdf
         self.wb = WholeBody(robot, point_spacing=self.config.chomp.point_spacing)
         self.dt = 1.0 / self.config.chomp.rate_hz
+        if backend not in BACKENDS:
+            raise InvalidArgumentError(
+                f"unknown CHOMP pass backend {backend!r}; known: {', '.join(BACKENDS)}"
+            )
+        self.backend = backend
         self._controllers: dict[int, ZmpPreviewController] = {}
 
     @property
@@ -219,7 +228,14 @@ class FootstepTrajectoryGenerator:
         status = ChompStatus.ITERATION_LIMIT
         while True:
             body = BodyPass(
-                self.wb, state, obstacle, cfg, validity, self.config.zmp.gravity, body_reference
+                self.wb,
+                state,
+                obstacle,
+                cfg,
+                validity,
+                self.config.zmp.gravity,
+                body_reference,
+                backend=self.backend,
             )
             chomp = Chomp(
                 body.smoothness,
@@ -247,6 +263,7 @@ class FootstepTrajectoryGenerator:
                 validity,
                 rest_feasible=body.feasible_without_leg(state.step.leg),
                 reference=swing_reference,
+                backend=self.backend,
             )
             chomp = Chomp(
                 swing.smoothness,

@@ -4,7 +4,9 @@
 current body poses." The variables are the swing leg's three joint angles at
 the airborne samples (lift-off and touchdown fixed); its points move with
 ∂p/∂q = R·J_pB. Updates are clamped to the joint limits, and a joint-speed
-term keeps the leg from dashing at its velocity limits.
+term keeps the leg from dashing at its velocity limits. The backends are
+those of :mod:`~roughwalk.trajectories.body_pass` (the core's
+``SwingPassEvaluator``, or numpy as the reference).
 """
 
 from __future__ import annotations
@@ -12,7 +14,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from roughwalk.trajectories.body_pass import clearance_ok, velocity_excess
+from roughwalk import _core
+from roughwalk.trajectories.body_pass import (
+    clearance_ok,
+    compiled_field,
+    resolve_backend,
+    velocity_excess,
+)
 from roughwalk.trajectories.chomp import Evaluation
 from roughwalk.trajectories.config import ChompConfig, ValidityConfig
 from roughwalk.trajectories.costs.joint_speed import joint_speed_cost
@@ -43,6 +51,8 @@ class SwingPass:
     reference:
         The airborne joint angles (n, 3) whose changes the smoothness term
         penalises (default: the current ones).
+    backend:
+        ``"auto"``, ``"rust"`` or ``"python"``.
     """
 
     def __init__(
@@ -54,6 +64,7 @@ class SwingPass:
         validity: ValidityConfig,
         rest_feasible: bool,
         reference: NDArray[np.float64] | None = None,
+        backend: str = "auto",
     ) -> None:
         self.wb = wb
         self.state = state
@@ -88,6 +99,34 @@ class SwingPass:
         self.active = np.ones((t, int(self.sel.sum())), dtype=bool)
         # The foot touches down at both ends of the window.
         self.active[[0, -1]] &= ~self.is_foot[None, :]
+        self.footholds = np.array([state.step.start, state.step.target])
+        self.backend = resolve_backend(backend, sdf)
+        self._rust: _core.SwingPassEvaluator | None = None
+        field = compiled_field(sdf)
+        if field is not None and self.backend == "rust":
+            pts = wb.points
+            q = state.q
+            self._rust = _core.SwingPassEvaluator(
+                wb.core,
+                field,
+                pts.leg,
+                pts.link,
+                pts.local,
+                pts.radius,
+                pts.is_foot,
+                self.leg,
+                self.body[:, :3],
+                self.rotation,
+                np.array([q[state.lift_off, self.leg], q[state.touchdown, self.leg]]),
+                self.active,
+                wb.velocity_limit[self.leg],
+                dt=state.dt,
+                speed_fraction=config.speed_fraction,
+                speed_weight=config.speed_weight * self.h,
+                obstacle_epsilon=config.obstacle_epsilon,
+                obstacle_weight=config.obstacle_weight,
+                gradient=config.gradient,
+            )
 
     @property
     def initial(self) -> NDArray[np.float64]:
@@ -104,7 +143,39 @@ class SwingPass:
         return q
 
     def evaluate(self, xi: NDArray[np.float64]) -> Evaluation:
-        """Obstacle term of the swing leg's points and its gradient (n, 3) at ξ."""
+        """Obstacle and joint-speed terms of the swing leg and their gradient (n, 3) at ξ."""
+        if self._rust is None:
+            return self.evaluate_python(xi)
+        r = self._rust.evaluate(np.ascontiguousarray(xi, dtype=float))
+        excess = float(r["velocity_excess"])
+        parts = {"obstacle": float(r["obstacle"]), "joint_speed": float(r["joint_speed"])}
+        return Evaluation(
+            parts["obstacle"] + parts["joint_speed"],
+            r["gradient"],
+            parts,
+            self._feasible(excess, r["clearance"], r["points"]),
+            excess,
+        )
+
+    def _feasible(
+        self, excess: float, clearance: NDArray[np.float64], points: NDArray[np.float64]
+    ) -> bool:
+        return (
+            self.rest_feasible
+            and excess == 0.0
+            and clearance_ok(
+                clearance,
+                self.active,
+                points,
+                self.is_foot,
+                self.footholds,
+                self.validity,
+                self.state.contact_clearance,
+            )
+        )
+
+    def evaluate_python(self, xi: NDArray[np.float64]) -> Evaluation:
+        """:meth:`evaluate` in numpy: the reference of the Rust evaluation."""
         q = self._window_q(xi)
         frames = self.wb.link_frames(q)
         p_b, _ = self.wb.points_base(q, frames)
@@ -125,24 +196,11 @@ class SwingPass:
         )
         grad += speed_grad
         excess = velocity_excess(q[:, self.leg], self.state.dt, self.wb.velocity_limit[self.leg])
-        feasible = (
-            self.rest_feasible
-            and excess == 0.0
-            and clearance_ok(
-                obs.clearance,
-                self.active,
-                points,
-                self.is_foot,
-                np.array([self.state.step.start, self.state.step.target]),
-                self.validity,
-                self.state.contact_clearance,
-            )
-        )
         return Evaluation(
             obs.value + speed_value,
             grad,
             {"obstacle": obs.value, "joint_speed": speed_value},
-            feasible,
+            self._feasible(excess, obs.clearance, points),
             excess,
         )
 

@@ -185,6 +185,11 @@ class WholeBody:
                 f"robot '{robot.name}' cannot be used for footstep trajectories: {e}"
             ) from None
 
+    @property
+    def core(self) -> _core.Quadruped:
+        """The Rust core's model of the four legs (batched IK, CHOMP pass evaluation)."""
+        return self._core
+
     # ---- frames ---------------------------------------------------------------
 
     def link_frames(self, q: ArrayLike) -> Frames:
