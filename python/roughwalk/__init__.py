@@ -17,6 +17,7 @@ from roughwalk.planning.footstep_planner import plan_footsteps
 from roughwalk.robots import Robot, load_robot
 from roughwalk.sim.run import run
 from roughwalk.terrain import Terrain, load_terrain
+from roughwalk.tracking.track import track
 from roughwalk.trajectories.api import footstep_trajectories
 from roughwalk.trajopt import optimize_motion
 
@@ -36,4 +37,5 @@ __all__ = [
     "plan_footsteps",
     "optimize_motion",
     "footstep_trajectories",
+    "track",
 ]

@@ -154,6 +154,7 @@ def test_contact_state_machine_early_late_flicker_and_slip():
     # A touch early in the swing is a scuff; after half the swing it is an early touchdown.
     est = sm.update(0.01, planned, [0.0, 0.3, 0.7, 0.0], [100.0, 20.0, 20.0, 100.0], zero)
     assert est.states[1] == LegContact.SWING
+    assert est.states[1] == LegContact.SWING
     assert est.states[2] == LegContact.EARLY_TOUCHDOWN and est.stance[2]
     assert sm.counts["early_touchdown"] == 1
     # Leg 1 reaches its planned stance without touching: late, reaching down, no load.
@@ -166,10 +167,12 @@ def test_contact_state_machine_early_late_flicker_and_slip():
     assert sm.counts["late_touchdown"] == 1
     est = sm.update(0.13, planned, zero, [100.0, 30.0, 20.0, 100.0], zero)
     assert est.states[1] == LegContact.STANCE and est.late_since[1] == 0.0
-    # A stance touch flickering for less than 20 ms stays stance; longer is lost.
-    est = sm.update(0.14, planned, zero, [0.0, 30.0, 20.0, 100.0], zero)
+    # A loaded foot stays loaded down to the release force, and not below it.
+    est = sm.update(0.14, planned, zero, [3.0, 30.0, 20.0, 100.0], zero)
     assert est.states[0] == LegContact.STANCE
-    est = sm.update(0.20, planned, zero, [0.0, 30.0, 20.0, 100.0], zero)
+    est = sm.update(0.15, planned, zero, [0.5, 30.0, 20.0, 100.0], zero)
+    assert est.states[0] == LegContact.LATE_TOUCHDOWN
+    est = sm.update(0.16, planned, zero, [3.0, 30.0, 20.0, 100.0], zero)
     assert est.states[0] == LegContact.LATE_TOUCHDOWN
     # A sliding stance foot slips, counted once per onset.
     speed = np.array([0.0, 0.5, 0.0, 0.0])

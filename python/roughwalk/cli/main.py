@@ -23,6 +23,7 @@ COMMAND_MODULES = [
     "roughwalk.cli.trajectory_cmd",
     "roughwalk.cli.run_cmd",
     "roughwalk.cli.replay_cmd",
+    "roughwalk.cli.track_cmd",
 ]
 
 

@@ -13,11 +13,18 @@ from roughwalk.tracking.config import (
     TrackingGains,
 )
 from roughwalk.tracking.contact_state import ContactEstimate, ContactStateMachine, LegContact
+from roughwalk.tracking.outcome import TrackingLog, TrackingOutcome
 from roughwalk.tracking.reference import Reference, ReferenceSample, load_trajectory
 from roughwalk.tracking.tasks import LeastSquaresTask, QPLayout
+from roughwalk.tracking.track import TrunkPush, execute_reference, track
 from roughwalk.tracking.whole_body_qp import QPSolution, WholeBodyQP, friction_pyramid
 
 __all__ = [
+    "track",
+    "execute_reference",
+    "TrunkPush",
+    "TrackingOutcome",
+    "TrackingLog",
     "TrackingConfig",
     "TrackingGains",
     "TaskWeights",

@@ -39,6 +39,15 @@ class TrackingGains:
     slip_gain_scale:
         Factor on the stance-foot weight and on the base gains while a foot
         slips: holding the foot harder is what stops a slip.
+    foothold_velocity_gain:
+        Swing feet land this many seconds [s] of base velocity error further
+        along (the capture point's √(h/g) ≈ 0.22 s for ANYmal C): the one
+        correction a trotting base has in the direction its two feet cannot
+        push. 0 lands exactly on the plan.
+    foothold_position_gain:
+        Fraction of the base position error added to the footholds.
+    max_foothold_shift_m:
+        Largest foothold correction [m].
     """
 
     base_kp: float = 100.0
@@ -48,9 +57,17 @@ class TrackingGains:
     swing_kp: float = 400.0
     swing_kd: float = 40.0
     slip_gain_scale: float = 3.0
+    foothold_velocity_gain: float = 0.22
+    foothold_position_gain: float = 0.5
+    max_foothold_shift_m: float = 0.12
 
     def __post_init__(self) -> None:
-        _positive(self, tuple(self.__dataclass_fields__), "gains")
+        _positive(self, tuple(self.__dataclass_fields__)[:7] + ("max_foothold_shift_m",), "gains")
+        if not (self.foothold_velocity_gain >= 0 and self.foothold_position_gain >= 0):
+            raise ConfigError(
+                "gains.foothold_velocity_gain and gains.foothold_position_gain must be ≥ 0, got "
+                f"{self.foothold_velocity_gain}, {self.foothold_position_gain}"
+            )
 
 
 @dataclass(frozen=True)
@@ -92,6 +109,8 @@ class ContactStateConfig:
     ----------
     contact_force_n:
         A foot touches when its measured normal force exceeds this [N].
+    release_force_n:
+        A loaded foot stays loaded until its normal force drops under this [N].
     early_touchdown_phase:
         A swing foot that touches after this fraction of its swing is treated
         as in stance (an early touchdown); before it, the touch is a scuff.
@@ -105,6 +124,7 @@ class ContactStateConfig:
     """
 
     contact_force_n: float = 5.0
+    release_force_n: float = 1.0
     early_touchdown_phase: float = 0.5
     search_speed_m_s: float = 0.3
     search_depth_m: float = 0.1

@@ -28,8 +28,6 @@ from roughwalk.tracking.config import ContactStateConfig
 
 __all__ = ["LegContact", "ContactEstimate", "ContactStateMachine"]
 
-_LOSS_TIME_S = 0.02  # a stance foot's touch may flicker this long [s] (impacts bounce)
-
 
 class LegContact(enum.Enum):
     """What a leg is doing, planned and measured together."""
@@ -82,7 +80,6 @@ class ContactStateMachine:
         self.config = config if config is not None else ContactStateConfig()
         self.states: list[LegContact] = [LegContact.STANCE] * 4
         self._late_start = np.full(4, np.nan)
-        self._last_touch = np.full(4, -np.inf)
         self.counts = {"early_touchdown": 0, "late_touchdown": 0, "slip": 0}
         self._slipping = np.zeros(4, dtype=bool)
 
@@ -112,18 +109,21 @@ class ContactStateMachine:
         cfg = self.config
         planned = np.asarray(planned_contact, dtype=bool)
         progress = np.asarray(swing_progress, dtype=float)
-        touching = np.asarray(normal_force, dtype=float) > cfg.contact_force_n
+        normal = np.asarray(normal_force, dtype=float)
+        touching = normal > cfg.contact_force_n
+        # Hysteresis, not a delay: a loaded foot stays loaded down to a smaller
+        # force, but one that has left the ground must not be pushed on (the
+        # torques meant for a contact would whirl a free leg).
+        holding = normal > cfg.release_force_n
         speed = np.asarray(foot_speed, dtype=float)
-        self._last_touch[touching] = t
-        recently = (t - self._last_touch) <= _LOSS_TIME_S
         for leg in range(4):
             old = self.states[leg]
             if planned[leg]:
-                if touching[leg] or (old.bears_load and recently[leg]):
+                if touching[leg] or (old.bears_load and holding[leg]):
                     new = LegContact.STANCE
                 else:
                     new = LegContact.LATE_TOUCHDOWN
-            elif old == LegContact.EARLY_TOUCHDOWN and recently[leg]:
+            elif old == LegContact.EARLY_TOUCHDOWN and holding[leg]:
                 new = LegContact.EARLY_TOUCHDOWN
             elif touching[leg] and progress[leg] >= cfg.early_touchdown_phase:
                 new = LegContact.EARLY_TOUCHDOWN
@@ -139,7 +139,7 @@ class ContactStateMachine:
                 self._late_start[leg] = np.nan
             self.states[leg] = new
         stance = np.array([s.bears_load for s in self.states])
-        slipping = stance & touching & (speed > cfg.slip_speed_m_s)
+        slipping = stance & holding & (speed > cfg.slip_speed_m_s)
         self.counts["slip"] += int(np.count_nonzero(slipping & ~self._slipping))
         self._slipping = slipping
         late = np.where(np.isnan(self._late_start), 0.0, t - np.nan_to_num(self._late_start))

@@ -18,7 +18,7 @@ bypassed those limits.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import mujoco
@@ -163,6 +163,9 @@ class WholeBodyController:
         world = self.world
         m, d = world.model, world.data
         state = measure(world)
+        # measure() gives the trunk's centre-of-mass velocity; the tasks need
+        # the base frame origin's, which is the free joint's q̇[0:3].
+        state = replace(state, base_vel=d.qvel[0:3].copy())
         ref = self.reference(t)
         points = state.feet - self.foot_radius * _Z
         jac, bias = self._foot_jacobians(points)
@@ -252,11 +255,23 @@ class WholeBodyController:
         trunk = quat_to_matrix(d.qpos[3:7])
         j_ang = np.zeros((3, self.nv))
         j_ang[:, 3:6] = trunk
-        tasks = [
-            motion_task("base_linear", layout, j_lin, np.zeros(3), a_lin, w.base_linear),
-            motion_task("base_angular", layout, j_ang, np.zeros(3), a_ang, w.base_angular),
-        ]
+        tasks: list[LeastSquaresTask] = []
+        if len(stance):
+            # In flight nothing but gravity moves the base: a base task would
+            # only whirl the legs to turn the trunk by reaction.
+            tasks += [
+                motion_task("base_linear", layout, j_lin, np.zeros(3), a_lin, w.base_linear),
+                motion_task("base_angular", layout, j_ang, np.zeros(3), a_ang, w.base_angular),
+            ]
         c = cfg.contact
+        # Raibert/capture-point foothold correction, blended in over the swing.
+        shift = g.foothold_velocity_gain * (state.base_vel - ref.base_vel) + (
+            g.foothold_position_gain * (state.base_pos - ref.base_pos)
+        )
+        shift[2] = 0.0
+        norm = float(np.linalg.norm(shift))
+        if norm > g.max_foothold_shift_m:
+            shift *= g.max_foothold_shift_m / norm
         for leg in range(4):
             s = estimate.states[leg]
             if s.bears_load:
@@ -268,8 +283,12 @@ class WholeBodyController:
                 )
                 continue
             target, target_vel, target_acc = ref.feet_pos[leg], ref.feet_vel[leg], ref.feet_acc[leg]
+            if s == LegContact.SWING:
+                blend = float(np.clip(ref.swing_progress[leg], 0.0, 1.0))
+                target = target + blend * shift
             if s == LegContact.LATE_TOUCHDOWN:
                 # Keep reaching down until the ground is found (or too deep).
+                target = target + shift
                 depth = min(c.search_speed_m_s * estimate.late_since[leg], c.search_depth_m)
                 target = target - depth * _Z
                 target_vel = -c.search_speed_m_s * _Z if depth < c.search_depth_m else np.zeros(3)
