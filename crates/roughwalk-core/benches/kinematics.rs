@@ -7,59 +7,11 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use roughwalk_core::kinematics::{
-    point_pose_jacobians, CollisionPoint, LegChain, LegParams, Quadruped,
-};
-
-/// LittleDog's leg numbers (MIT's URDF): x forward, y left, z up.
-fn littledog_leg(name: &str, front: bool, side: f64) -> LegChain {
-    let x = if front { 0.101 } else { -0.101 };
-    let shin_x = if front { -0.0265 } else { 0.0265 };
-    LegChain::new(
-        name,
-        LegParams {
-            body_pos: [
-                [x, side * 0.03625, 0.0],
-                [0.0, side * 0.0236, -0.0166],
-                [0.0, 0.0, -0.0751],
-            ],
-            body_quat: [[1.0, 0.0, 0.0, 0.0]; 3],
-            anchor: [[0.0; 3]; 3],
-            axis: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
-            lower: if front {
-                [-0.6, -3.5, -3.1]
-            } else {
-                [-0.6, -2.4, -1.0]
-            },
-            upper: if front {
-                [0.6, 2.4, 1.0]
-            } else {
-                [0.6, 3.5, 3.1]
-            },
-            velocity_limit: [f64::INFINITY; 3],
-            foot: [shin_x, 0.0, -0.0985],
-            foot_radius: 0.01,
-            knee_sign: if front { -1.0 } else { 1.0 },
-        },
-    )
-    .expect("LittleDog's leg is a valid chain")
-}
-
-fn littledog() -> Quadruped {
-    Quadruped::new([
-        littledog_leg("LF", true, 1.0),
-        littledog_leg("RF", true, -1.0),
-        littledog_leg("LH", false, 1.0),
-        littledog_leg("RH", false, -1.0),
-    ])
-}
-
-const STANCE_Q: [f64; 12] = [
-    0.05, 0.6, -1.1, -0.05, 0.6, -1.1, 0.05, -0.6, 1.1, -0.05, -0.6, 1.1,
-];
+use roughwalk_core::kinematics::{point_pose_jacobians, CollisionPoint};
+use roughwalk_core::testing::{littledog, littledog_leg, STANCE_Q};
 
 fn single_leg(c: &mut Criterion) {
-    let leg = littledog_leg("LF", true, 1.0);
+    let leg = littledog_leg(1.0, true);
     let q = [0.1, 0.5, -1.2];
     let reachable = leg.fk(q);
     let out_of_reach = [0.4, 0.1, -0.3];

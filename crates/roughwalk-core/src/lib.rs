@@ -12,6 +12,8 @@ pub mod kinematics;
 pub mod sdf;
 pub mod search;
 pub mod trajectory;
+#[doc(hidden)]
+pub mod testing;
 
 pub use error::{CoreError, CoreResult};
 pub use heightfield::{HeightField, Interpolation};

@@ -385,22 +385,21 @@ impl CertificateSearch<'_> {
                 // the target's radial projection: one analytic IK instead of
                 // the exact closest-point search, 30-50x dearer (§3.2 needs
                 // only the direction and size of the error).
-                let ik = match self.reach[i].aim(target) {
-                    Some(aim) => {
-                        let near = leg.ik(aim, None);
-                        if near.reachable {
-                            IkResult {
+                let (ik, leg_frames) = match self.reach[i].aim(target) {
+                    Some(aim) => match leg.ik_exact(aim, None) {
+                        Some((near, near_frames)) => {
+                            let near = IkResult {
                                 reachable: false,
                                 ..near
-                            }
-                        } else {
-                            leg.ik(target, None)
+                            };
+                            (near, near_frames)
                         }
-                    }
-                    None => leg.ik(target, None),
+                        None => leg.ik_with_frames(target, None),
+                    },
+                    None => leg.ik_with_frames(target, None),
                 };
                 q[3 * i..3 * i + 3].copy_from_slice(&ik.q);
-                frames[i] = leg.link_frames(ik.q);
+                frames[i] = leg_frames;
                 if !ik.reachable {
                     // Zucker 2011, §3.2: a virtual force at the reachable foot toward its target.
                     reachable = false;
@@ -558,12 +557,10 @@ impl CertificateSearch<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::footstep::collision::tests::{littledog_capsules, sdf_of};
-    use crate::footstep::config::tests::test_config;
-    use crate::footstep::mass_model::tests::littledog_mass;
+    use crate::footstep::collision::tests::sdf_of;
     use crate::kinematics::math::quat_to_mat;
-    use crate::kinematics::quadruped::tests::littledog;
     use crate::kinematics::support::{closest_point_with_margin, support_polygon_margin};
+    use crate::testing::CertificateFixture;
     use proptest::prelude::*;
 
     proptest! {
@@ -614,23 +611,9 @@ mod tests {
     fn footstep_certificate_holds_feet_com_and_clearance() {
         let height = |x: f64, y: f64| 0.01 * (10.0 * x).sin() * (8.0 * y).cos();
         let (_, sdf) = sdf_of(height);
-        let robot = littledog();
-        let mass = littledog_mass();
-        let collision = littledog_capsules();
-        let config = test_config().certificate;
-        let reach = robot.legs().clone().map(|l| LegReach::of(&l));
-        let search = CertificateSearch {
-            robot: &robot,
-            mass: &mass,
-            collision: &collision,
-            sdf: &sdf,
-            config: &config,
-            nominal_height: 0.1685,
-            nominal_feet_centroid: [0.0, 0.0],
-            nominal_com: [0.0, 0.0, -0.02],
-            sdf_error: 0.5 * 3f64.sqrt() * 0.005,
-            reach: &reach,
-        };
+        let fixture = CertificateFixture::default();
+        let search = fixture.search(&sdf, 0.5 * 3f64.sqrt() * 0.005);
+        let (robot, mass, config) = (&fixture.robot, &fixture.mass, &fixture.config);
         let (feet, contacts) = stance(&height, [0.3, 0.0], 0.3);
         for support in [[1, 2, 3], [0, 1, 3]] {
             let cert = search
@@ -676,23 +659,9 @@ mod tests {
             (0.2 - 30.0 * r2).clamp(0.0, 0.13)
         };
         let (_, sdf) = sdf_of(height);
-        let robot = littledog();
-        let mass = littledog_mass();
-        let collision = littledog_capsules();
-        let config = test_config().certificate;
-        let reach = robot.legs().clone().map(|l| LegReach::of(&l));
-        let search = CertificateSearch {
-            robot: &robot,
-            mass: &mass,
-            collision: &collision,
-            sdf: &sdf,
-            config: &config,
-            nominal_height: 0.1685,
-            nominal_feet_centroid: [0.0, 0.0],
-            nominal_com: [0.0, 0.0, -0.02],
-            sdf_error: 0.0,
-            reach: &reach,
-        };
+        let fixture = CertificateFixture::default();
+        let search = fixture.search(&sdf, 0.0);
+        let (robot, collision, config) = (&fixture.robot, &fixture.collision, &fixture.config);
         let (feet, contacts) = stance(&height, [0.3, 0.0], 0.0);
         let guess = search.initial_pose(&feet, &contacts, &[1, 2, 3], 0.0);
         let frames: [LinkFrames; 4] = std::array::from_fn(|i| {

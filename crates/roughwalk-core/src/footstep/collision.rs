@@ -181,66 +181,11 @@ pub(crate) mod tests {
     use crate::kinematics::math::IDENTITY;
     use crate::kinematics::quadruped::leg_q;
     use crate::kinematics::quadruped::tests::{littledog, STANCE_Q};
-    use crate::sdf::{Band, GridSpec, HeightFieldDistance};
+    pub use crate::testing::littledog_capsules;
 
     /// The SDF of a height field z(x, y) on [0, 0.6] × [−0.3, 0.3] at 5 mm.
     pub fn sdf_of(height: impl Fn(f64, f64) -> f64) -> (HeightField, SignedDistanceField) {
-        let h = 0.005;
-        let (nx, ny) = (121, 121);
-        let heights: Vec<f64> = (0..nx * ny)
-            .map(|k| height((k / ny) as f64 * h, -0.3 + (k % ny) as f64 * h))
-            .collect();
-        let hf = HeightField::new(0.0, -0.3, h, h, nx, ny, heights, None).unwrap();
-        let (lo, hi) = hf.height_range();
-        let spec = GridSpec::new(
-            [0.0, -0.3, lo - 0.1],
-            h,
-            [nx, ny, ((hi - lo + 0.4) / h) as usize + 1],
-        )
-        .unwrap();
-        let sdf = Band::from_heightfield(HeightFieldDistance::new(hf.clone()), spec, 2.0)
-            .unwrap()
-            .finish()
-            .unwrap();
-        (hf, sdf)
-    }
-
-    /// LittleDog's collision capsules without the feet (the shipped MJCF).
-    pub fn littledog_capsules() -> CollisionModel {
-        let mut caps = vec![
-            Capsule {
-                leg: None,
-                link: 0,
-                a: [-0.12, -0.02, 0.0],
-                b: [0.12, -0.02, 0.0],
-                radius: 0.036,
-            },
-            Capsule {
-                leg: None,
-                link: 0,
-                a: [-0.12, 0.02, 0.0],
-                b: [0.12, 0.02, 0.0],
-                radius: 0.036,
-            },
-        ];
-        for leg in 0..4 {
-            let sx = if leg < 2 { 1.0 } else { -1.0 };
-            caps.push(Capsule {
-                leg: Some(leg),
-                link: 1,
-                a: [0.0; 3],
-                b: [0.0, 0.0, -0.0751],
-                radius: 0.011,
-            });
-            caps.push(Capsule {
-                leg: Some(leg),
-                link: 2,
-                a: [0.0; 3],
-                b: [-sx * 0.0212, 0.0, -0.0788],
-                radius: 0.009,
-            });
-        }
-        CollisionModel::new(caps).unwrap()
+        crate::testing::terrain(0.6, height, 0.1, 0.3)
     }
 
     /// Brute force: every capsule sampled every 0.5 mm.

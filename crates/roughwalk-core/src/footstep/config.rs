@@ -281,62 +281,7 @@ impl FootstepConfig {
 pub(crate) mod tests {
     use super::*;
 
-    /// A LittleDog-sized configuration (hip-to-hip length 0.2 m) for tests.
-    pub fn test_config() -> FootstepConfig {
-        let l = 0.2;
-        let mut actions = Vec::new();
-        for dx in [-0.1, 0.0, 0.1, 0.2, 0.3] {
-            for dy in [-0.1, 0.0, 0.1] {
-                actions.push([dx * l, dy * l, 0.0]);
-            }
-        }
-        for dth in [-0.15, 0.15] {
-            actions.push([0.0, 0.0, dth]);
-            actions.push([0.15 * l, 0.0, dth]);
-        }
-        FootstepConfig {
-            resolution: 0.005,
-            actions,
-            walking_order: [2, 0, 3, 1],
-            local_search_radius: 0.01,
-            local_search_penalty: 0.1,
-            max_foot_travel: 0.6 * l,
-            min_foot_separation: 0.2 * l,
-            crossing_margin: 0.05 * l,
-            step_cost: 1.0,
-            incircle_preferred: 0.18 * l,
-            incircle_min: 0.08 * l,
-            incircle_penalty: 1.0,
-            certificate: CertificateConfig {
-                max_iterations: 25,
-                stall_rounds: 3,
-                alpha_reach: 0.7,
-                beta_reach: 0.5 / (0.5 * l * 0.5 * l),
-                reach_overshoot: 0.002,
-                alpha_obstacle: 0.7,
-                beta_obstacle: 0.3 / (0.5 * l * 0.5 * l),
-                com_margin: 0.05 * l,
-                max_step: 0.1 * l,
-                max_turn: 0.15,
-                max_drift: 0.5 * l,
-                clearance: 0.004,
-                clearance_overshoot: 0.002,
-                preferred_clearance: 0.01,
-                clearance_penalty: 0.5,
-                singularity_margin: 0.25,
-                singularity_penalty: 0.5,
-                max_tilt: 0.5,
-            },
-            goal_radius: 0.25 * l,
-            heuristic: HeuristicKind::Dubins,
-            turning_radius: l,
-            dubins_cost_per_metre: 0.0,
-            epsilon0: 3.0,
-            epsilon_decrement: 0.5,
-            max_tree_edges: 10_000,
-            cache_capacity: 1 << 20,
-        }
-    }
+    pub use crate::testing::test_config;
 
     #[test]
     fn footstep_config_validation_names_the_field() {

@@ -83,23 +83,7 @@ pub(crate) mod tests {
     use crate::kinematics::quadruped::tests::{littledog, STANCE_Q};
     use crate::kinematics::quadruped::{leg_q, Quadruped};
 
-    /// LittleDog's masses (the shipped MJCF).
-    pub fn littledog_mass() -> MassModel {
-        let side = |leg: usize| if leg.is_multiple_of(2) { 1.0 } else { -1.0 };
-        MassModel::new(
-            1.8,
-            [0.0; 3],
-            [[0.0623, 0.1279, 0.0464]; 4],
-            std::array::from_fn(|leg| {
-                [
-                    [0.0, side(leg) * 0.0029, 0.0],
-                    [0.0, 0.0, -0.0166],
-                    [0.0, 0.0, -0.0202],
-                ]
-            }),
-        )
-        .unwrap()
-    }
+    pub use crate::testing::littledog_mass;
 
     fn frames(robot: &Quadruped, q: &[f64; 12]) -> [LinkFrames; 4] {
         std::array::from_fn(|i| robot.legs()[i].link_frames(leg_q(q, i)))

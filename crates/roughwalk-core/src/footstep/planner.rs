@@ -336,54 +336,9 @@ impl FootstepPlanner {
 #[allow(clippy::float_cmp)]
 pub(crate) mod tests {
     use super::*;
-    use crate::footstep::collision::tests::littledog_capsules;
-    use crate::footstep::config::tests::test_config;
     use crate::footstep::config::HeuristicKind;
-    use crate::footstep::mass_model::tests::littledog_mass;
     use crate::kinematics::math::{norm, sub};
-    use crate::kinematics::quadruped::tests::littledog;
-    use crate::sdf::{Band, GridSpec, HeightFieldDistance};
-
-    pub const NOMINAL_Q: [f64; 12] = [
-        0.0, 0.6, -1.2, 0.0, 0.6, -1.2, 0.0, -0.6, 1.2, 0.0, -0.6, 1.2,
-    ];
-
-    pub fn littledog_robot() -> FootstepRobot {
-        FootstepRobot {
-            quadruped: littledog(),
-            mass: littledog_mass(),
-            collision: littledog_capsules(),
-            nominal_q: NOMINAL_Q,
-        }
-    }
-
-    /// A planner on [0, length] × [−0.3, 0.3] with heights `height`, terrain
-    /// costs `cost` (the same for front and hind feet) and `config`.
-    pub fn planner(
-        length: f64,
-        height: impl Fn(f64, f64) -> f64,
-        cost: impl Fn(f64, f64) -> f64,
-        config: FootstepConfig,
-    ) -> FootstepPlanner {
-        let h = 0.005;
-        let (nx, ny) = ((length / h).round() as usize + 1, 121);
-        let xy = |k: usize| ((k / ny) as f64 * h, -0.3 + (k % ny) as f64 * h);
-        let heights: Vec<f64> = (0..nx * ny).map(|k| height(xy(k).0, xy(k).1)).collect();
-        let costs: Vec<f64> = (0..nx * ny).map(|k| cost(xy(k).0, xy(k).1)).collect();
-        let hf = HeightField::new(0.0, -0.3, h, h, nx, ny, heights, None).unwrap();
-        let (lo, hi) = hf.height_range();
-        let spec = GridSpec::new(
-            [0.0, -0.3, lo - 0.05],
-            h,
-            [nx, ny, ((hi - lo + 0.35) / h) as usize + 1],
-        )
-        .unwrap();
-        let sdf = Band::from_heightfield(HeightFieldDistance::new(hf.clone()), spec, 2.0)
-            .unwrap()
-            .finish()
-            .unwrap();
-        FootstepPlanner::new(littledog_robot(), &hf, sdf, &costs, &costs, config).unwrap()
-    }
+    pub use crate::testing::{planner, test_config};
 
     fn run(
         p: &mut FootstepPlanner,

@@ -1,6 +1,8 @@
 //! A footstep state and the foothold lattice it lives on (Zucker 2011, §4.1:
 //! "a state is the 2D (x, y) location for each foot").
 
+use std::hash::{Hash, Hasher};
+
 use crate::error::{CoreError, CoreResult};
 
 /// A lattice cell (i, j): the foothold at (x0 + i·h, y0 + j·h).
@@ -12,12 +14,35 @@ pub type Cell = [i16; 2];
 
 /// Where the four feet stand, in canonical leg order (LF, RF, LH, RH), and
 /// which step of the fixed walking order comes next.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FootstepState {
     /// Foothold cell of each leg, canonical order.
     pub feet: [Cell; 4],
     /// Index into the walking order of the leg that moves next (0..4).
     pub next: u8,
+}
+
+impl FootstepState {
+    /// Two legs' cell indices packed into one word (16 bits each).
+    #[inline]
+    fn packed(cells: &[Cell]) -> u64 {
+        cells
+            .iter()
+            .flatten()
+            .fold(0u64, |w, &i| (w << 16) | u64::from(i as u16))
+    }
+}
+
+impl Hash for FootstepState {
+    /// Three words, not the derived 22 (a length and four bytes per cell):
+    /// states are hashed once per successor in the search's table and the
+    /// certificate cache.
+    #[inline]
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        state.write_u64(Self::packed(&self.feet[..2]));
+        state.write_u64(Self::packed(&self.feet[2..]));
+        state.write_u8(self.next);
+    }
 }
 
 impl FootstepState {

@@ -92,6 +92,8 @@ pub struct LegChain {
     ik_geometry: ik::IkGeometry,
     /// Arcs bounding the foot's reach in the HFE/KFE plane (see `closest`).
     arcs: Vec<closest::PlanarArc>,
+    /// The HAA scan of the closest-point search.
+    scan: closest::HaaScan,
 }
 
 fn check_finite(name: &str, what: &str, values: &[f64]) -> CoreResult<()> {
@@ -173,6 +175,7 @@ impl LegChain {
         let haa_anchor_base = add(params.body_pos[0], mat_vec(&body_rot[0], params.anchor[0]));
         let ik_geometry = ik::IkGeometry::new(name, &params, &body_rot)?;
         let arcs = closest::planar_arcs(&ik_geometry, params.lower, params.upper);
+        let scan = closest::haa_scan(&ik_geometry, params.lower, params.upper);
         Ok(Self {
             name: name.to_owned(),
             params,
@@ -180,6 +183,7 @@ impl LegChain {
             haa_anchor_base,
             ik_geometry,
             arcs,
+            scan,
         })
     }
 
@@ -285,39 +289,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::kinematics::math::{axis_angle as rot, mat_t_vec, mat_to_quat};
 
-    /// A LittleDog-sized leg (URDF numbers), x = forward, y = left, z = up.
-    pub fn littledog_leg(side: f64, front: bool) -> LegChain {
-        let x = if front { 0.101 } else { -0.101 };
-        let shin_x = if front { -0.0265 } else { 0.0265 };
-        LegChain::new(
-            "littledog",
-            LegParams {
-                body_pos: [
-                    [x, side * 0.03625, 0.0],
-                    [0.0, side * 0.0236, -0.0166],
-                    [0.0, 0.0, -0.0751],
-                ],
-                body_quat: [[1.0, 0.0, 0.0, 0.0]; 3],
-                anchor: [[0.0; 3]; 3],
-                axis: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
-                lower: if front {
-                    [-0.6, -3.5, -3.1]
-                } else {
-                    [-0.6, -2.4, -1.0]
-                },
-                upper: if front {
-                    [0.6, 2.4, 1.0]
-                } else {
-                    [0.6, 3.5, 3.1]
-                },
-                velocity_limit: [f64::INFINITY; 3],
-                foot: [shin_x, 0.0, -0.0985],
-                foot_radius: 0.01,
-                knee_sign: if front { -1.0 } else { 1.0 },
-            },
-        )
-        .unwrap()
-    }
+    pub use crate::testing::littledog_leg;
 
     /// A leg with rotated body frames, nonzero anchors, an antiparallel knee
     /// axis and an in-plane shank offset (ANYmal-like): every term of the

@@ -99,6 +99,30 @@ pub(super) fn planar_arcs(g: &IkGeometry, lower: Vec3, upper: Vec3) -> Vec<Plana
     arcs
 }
 
+/// The HAA angles of the slice scan and the rotations −q_HAA about the HAA
+/// axis that bring a target into each slice's frame: fixed by the limits,
+/// so computed once per leg instead of once per out-of-reach IK.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct HaaScan {
+    q1: [f64; SCAN],
+    rot: [Mat3; SCAN],
+    /// Whether the range is a full turn (the scan wraps around).
+    full: bool,
+}
+
+pub(super) fn haa_scan(g: &IkGeometry, lower: Vec3, upper: Vec3) -> HaaScan {
+    let (start, span) = range(lower[0], upper[0]);
+    let full = span >= TAU;
+    let divisions = if full { SCAN } else { SCAN - 1 } as f64;
+    let q1: [f64; SCAN] =
+        std::array::from_fn(|i| (start + span * i as f64 / divisions).clamp(lower[0], upper[0]));
+    HaaScan {
+        q1,
+        rot: q1.map(|q| axis_angle(g.u1, -q)),
+        full,
+    }
+}
+
 impl PlanarArc {
     /// Distance [m] from `d` to the arc and the arc offset [rad] where it is attained.
     fn closest(&self, d: [f64; 2]) -> (f64, f64) {
@@ -132,12 +156,12 @@ impl PlanarArc {
 
 impl LegChain {
     /// Squared distance [m²] from the target to the feet reachable with HAA
-    /// at `q1`, and the (q_HFE, φ) attaining it. `t` is the target relative to
-    /// the HAA anchor in the hip frame at q_HAA = 0.
-    fn slice(&self, t: Vec3, q1: f64) -> (f64, f64, f64) {
+    /// at the scan's `k`-th angle, and the (q_HFE, φ) attaining it. `t` is
+    /// the target relative to the HAA anchor in the hip frame at q_HAA = 0.
+    fn slice(&self, t: Vec3, k: usize) -> (f64, f64, f64) {
         let g = &self.ik_geometry;
         let (lower, upper) = (self.params.lower, self.params.upper);
-        let t_hip = add(self.params.anchor[0], mat_vec(&axis_angle(g.u1, -q1), t));
+        let t_hip = add(self.params.anchor[0], mat_vec(&self.scan.rot[k], t));
         let rel = sub(t_hip, g.hfe_anchor);
         let h = dot(rel, g.n) - g.plane_offset;
         let d = [dot(rel, g.e1), dot(rel, g.e2)];
@@ -146,9 +170,9 @@ impl LegChain {
         } else {
             (-upper[2], -lower[2])
         };
-        let (branches, exact) = g.planar_branches(d);
-        if exact {
-            for (q2, phi) in branches {
+        if (-1.0..=1.0).contains(&g.cos_psi(d)) {
+            for sign in [1.0, -1.0] {
+                let (q2, phi) = g.planar_branch(d, sign);
                 let q2 = wrap_into_limits(q2, lower[1], upper[1]);
                 let phi = wrap_into_limits(phi, phi_lo, phi_hi);
                 if let (Some(q2), Some(phi)) = (q2, phi) {
@@ -158,6 +182,12 @@ impl LegChain {
         }
         let mut best = (f64::INFINITY, self.nominal()[1], 0.0);
         for arc in &self.arcs {
+            // The distance to an arc is at least that to its circle: skip
+            // arcs that cannot beat the best (it must be strictly less).
+            let (x, y) = (d[0] - arc.centre[0], d[1] - arc.centre[1]);
+            if (x.hypot(y) - arc.radius).abs() >= best.0 {
+                continue;
+            }
             let (dist, offset) = arc.closest(d);
             if dist < best.0 {
                 let (q2, phi) = arc.joints(offset);
@@ -169,13 +199,10 @@ impl LegChain {
 
     /// The joint angles within limits whose foot is closest to `target` (base frame [m]).
     pub(super) fn closest_within_limits(&self, target: Vec3) -> Vec3 {
-        let (lower, upper) = (self.params.lower, self.params.upper);
         let t = self.target_at_hip(target);
-        let (start, span) = range(lower[0], upper[0]);
-        let full = span >= TAU;
-        let divisions = if full { SCAN } else { SCAN - 1 } as f64;
-        let q1_at = |i: usize| (start + span * i as f64 / divisions).clamp(lower[0], upper[0]);
-        let slices: [(f64, f64, f64); SCAN] = std::array::from_fn(|i| self.slice(t, q1_at(i)));
+        let full = self.scan.full;
+        let q1_at = |i: usize| self.scan.q1[i];
+        let slices: [(f64, f64, f64); SCAN] = std::array::from_fn(|i| self.slice(t, i));
         let value = |i: usize| slices[i].0;
         let mut minima: Vec<usize> = (0..SCAN)
             .filter(|&i| {

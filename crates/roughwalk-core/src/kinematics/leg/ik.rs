@@ -8,7 +8,7 @@
 //! (two solutions), then HFE/KFE from a planar two-link problem (law of
 //! cosines, two knee branches).
 
-use super::{clamp_to, unit, IkResult, LegChain, LegParams, IK_TOLERANCE, LIMIT_SLACK};
+use super::{clamp_to, unit, IkResult, LegChain, LegParams, LinkFrames, IK_TOLERANCE, LIMIT_SLACK};
 use crate::error::{CoreError, CoreResult};
 use crate::kinematics::math::{
     add, cross, dot, mat_t_vec, mat_vec, norm, scale, solve, sub, wrap_angle, Mat3, Vec3,
@@ -125,21 +125,24 @@ impl IkGeometry {
         ]
     }
 
-    /// The planar two-link solutions (q_HFE, φ) placing the foot at `d`
-    /// (relative to the HFE anchor, in (e1, e2) [m]) for knee branches ψ > 0
-    /// and ψ < 0, and whether they are exact; out of the annulus of reach, the
-    /// foot points at `d`, straight or folded.
-    pub fn planar_branches(&self, d: [f64; 2]) -> ([(f64, f64); 2], bool) {
+    /// cos ψ of the knee angle that puts the foot at distance |d| from the
+    /// HFE anchor (outside [−1, 1] out of the annulus of reach).
+    #[inline]
+    pub fn cos_psi(&self, d: [f64; 2]) -> f64 {
         let (l1, l2) = (self.l1, self.l2);
-        let cos_psi = (d[0] * d[0] + d[1] * d[1] - l1 * l1 - l2 * l2) / (2.0 * l1 * l2);
-        let exact = (-1.0..=1.0).contains(&cos_psi);
-        let psi = cos_psi.clamp(-1.0, 1.0).acos();
-        let branch = |sign: f64| {
-            let phi = sign * psi + self.alpha1 - self.alpha2;
-            let m = self.planar_foot(phi);
-            (d[1].atan2(d[0]) - m[1].atan2(m[0]), phi)
-        };
-        ([branch(1.0), branch(-1.0)], exact)
+        (d[0] * d[0] + d[1] * d[1] - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)
+    }
+
+    /// The planar two-link solution (q_HFE, φ) placing the foot at `d`
+    /// (relative to the HFE anchor, in (e1, e2) [m]) on the knee branch of
+    /// sign `sign` (ψ > 0 for +1); out of the annulus of reach (|cos ψ| > 1),
+    /// the foot points at `d`, straight or folded. One branch at a time:
+    /// callers usually need only the first.
+    pub fn planar_branch(&self, d: [f64; 2], sign: f64) -> (f64, f64) {
+        let psi = self.cos_psi(d).clamp(-1.0, 1.0).acos();
+        let phi = sign * psi + self.alpha1 - self.alpha2;
+        let m = self.planar_foot(phi);
+        (d[1].atan2(d[0]) - m[1].atan2(m[0]), phi)
     }
 }
 
@@ -157,6 +160,61 @@ pub(super) fn wrap_into_limits(q: f64, lower: f64, upper: f64) -> Option<f64> {
     (v <= hi).then(|| v.clamp(lower, upper))
 }
 
+/// The four solutions (2 HAA × 2 knee branches) of the limit-free chain,
+/// most preferred first: HAA nearest its nominal angle, then the knee branch
+/// `knee`. Every candidate is finite; out of reach they are only
+/// approximate, which the caller detects from the foot error.
+///
+/// Candidate k is built on demand by [`Self::get`], with the very
+/// operations an eager construction would use, so the numbers are the same.
+struct AnalyticCandidates {
+    t_u: f64,
+    /// (v_w, q_HAA) of the two HAA solutions, preferred first.
+    haa: [(f64, f64); 2],
+    knee: f64,
+}
+
+impl AnalyticCandidates {
+    fn new(leg: &LegChain, target: Vec3, knee: f64) -> Self {
+        let g = &leg.ik_geometry;
+        let t = leg.target_at_hip(target);
+        let (t_u, t_n, t_w) = (dot(t, g.u1), dot(t, g.n_perp), dot(t, g.w));
+        let v_w_abs = (t_n * t_n + t_w * t_w - g.lateral * g.lateral)
+            .max(0.0)
+            .sqrt();
+        let nominal_haa = leg.nominal()[0];
+        let polar = t_w.atan2(t_n);
+        let mut haa = [v_w_abs, -v_w_abs].map(|v_w| (v_w, polar - v_w.atan2(g.lateral)));
+        if wrap_angle(haa[0].1 - nominal_haa).abs() > wrap_angle(haa[1].1 - nominal_haa).abs() {
+            haa.swap(0, 1);
+        }
+        Self { t_u, haa, knee }
+    }
+
+    /// Candidate `k` (0..4): HAA solution k / 2, knee branch k % 2 in order
+    /// of preference.
+    fn get(&self, leg: &LegChain, k: usize) -> Vec3 {
+        let g = &leg.ik_geometry;
+        let (v_w, q1) = self.haa[k / 2];
+        // Where the foot must be in the hip frame once HAA has turned it into place.
+        let foot_hip = add(
+            leg.params.anchor[0],
+            add(
+                add(scale(g.u1, self.t_u), scale(g.n_perp, g.lateral)),
+                scale(g.w, v_w),
+            ),
+        );
+        let rel = sub(foot_hip, g.hfe_anchor);
+        let sign = if (self.knee > 0.0) == k.is_multiple_of(2) {
+            1.0
+        } else {
+            -1.0
+        };
+        let (q2, phi) = g.planar_branch([dot(rel, g.e1), dot(rel, g.e2)], sign);
+        [q1, q2, g.knee_axis_sign * phi]
+    }
+}
+
 impl LegChain {
     /// Inverse kinematics IK_B: joint angles placing the foot centre at
     /// `target` (base frame [m]), or, when that is impossible within the joint
@@ -166,53 +224,101 @@ impl LegChain {
     /// [`LegParams::knee_sign`]); the other branch is used only when the
     /// preferred one violates a limit. Never panics and never returns NaN.
     pub fn ik(&self, target: Vec3, knee_sign: Option<f64>) -> IkResult {
+        self.ik_with_frames(target, knee_sign).0
+    }
+
+    /// [`Self::ik`] and the link frames at its joint angles, as
+    /// [`Self::link_frames`] gives them: the IK's last forward kinematics
+    /// already computed them, and callers that need both (the pose
+    /// certificate) save a second evaluation of every joint's rotation.
+    pub fn ik_with_frames(&self, target: Vec3, knee_sign: Option<f64>) -> (IkResult, LinkFrames) {
         if !target.iter().all(|v| v.is_finite()) {
-            return IkResult {
-                q: self.nominal(),
+            let q = self.nominal();
+            let result = IkResult {
+                q,
                 reachable: false,
                 within_limits: true,
                 error: f64::INFINITY,
             };
+            return (result, self.link_frames(q));
         }
+        let solve_target = self.solve_target(target);
+        if let Some(found) = self.ik_exact_at(solve_target, target, knee_sign) {
+            return found;
+        }
+        let q = self.closest_within_limits(solve_target);
+        let frames = self.link_frames(q);
+        let foot = add(frames.pos[2], mat_vec(&frames.rot[2], self.params.foot));
+        let error = norm(sub(foot, target));
+        let reachable = error <= IK_TOLERANCE;
+        let on_limit = (0..3).any(|k| {
+            q[k] <= self.params.lower[k] + LIMIT_SLACK || q[k] >= self.params.upper[k] - LIMIT_SLACK
+        });
+        let result = IkResult {
+            q,
+            reachable,
+            within_limits: reachable || !on_limit,
+            error,
+        };
+        (result, frames)
+    }
+
+    /// The analytic part of [`Self::ik_with_frames`] alone: the joint angles
+    /// within limits that put the foot on `target` (base frame [m]), with
+    /// their link frames, or `None` without the closest-reachable search
+    /// that `ik` falls back to (for callers that only ask whether a point
+    /// can be reached).
+    pub fn ik_exact(&self, target: Vec3, knee_sign: Option<f64>) -> Option<(IkResult, LinkFrames)> {
+        if !target.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        self.ik_exact_at(self.solve_target(target), target, knee_sign)
+    }
+
+    /// The point the analytic IK solves for: `target`, pulled in to
+    /// [`FAR_TARGET`] from the hip.
+    fn solve_target(&self, target: Vec3) -> Vec3 {
+        let from_hip = sub(target, self.haa_anchor_base);
+        let dist = norm(from_hip);
+        if dist > FAR_TARGET {
+            add(self.haa_anchor_base, scale(from_hip, FAR_TARGET / dist))
+        } else {
+            target
+        }
+    }
+
+    fn ik_exact_at(
+        &self,
+        solve_target: Vec3,
+        target: Vec3,
+        knee_sign: Option<f64>,
+    ) -> Option<(IkResult, LinkFrames)> {
         let knee = if knee_sign.unwrap_or(self.params.knee_sign) < 0.0 {
             -1.0
         } else {
             1.0
         };
-        let from_hip = sub(target, self.haa_anchor_base);
-        let dist = norm(from_hip);
-        let solve_target = if dist > FAR_TARGET {
-            add(self.haa_anchor_base, scale(from_hip, FAR_TARGET / dist))
-        } else {
-            target
-        };
-        for q in self.analytic_candidates(solve_target, knee) {
+        // Candidates are built one at a time: the first usually fits, and
+        // each costs a handful of atan2/acos/sin_cos.
+        let candidates = AnalyticCandidates::new(self, solve_target, knee);
+        for k in 0..4 {
+            let q = candidates.get(self, k);
             let wrapped = [0, 1, 2]
                 .map(|k| wrap_into_limits(q[k], self.params.lower[k], self.params.upper[k]));
             if let [Some(a), Some(b), Some(c)] = wrapped {
-                let (q, error) = self.polish([a, b, c], target);
+                let (q, error, frames) = self.polish([a, b, c], target);
                 if error <= IK_TOLERANCE {
-                    return IkResult {
+                    let result = IkResult {
                         q,
                         reachable: true,
                         within_limits: true,
                         error,
                     };
+                    return Some((result, frames));
                 }
             }
         }
-        let q = self.closest_within_limits(solve_target);
-        let error = norm(sub(self.fk(q), target));
-        let reachable = error <= IK_TOLERANCE;
-        let on_limit = (0..3).any(|k| {
-            q[k] <= self.params.lower[k] + LIMIT_SLACK || q[k] >= self.params.upper[k] - LIMIT_SLACK
-        });
-        IkResult {
-            q,
-            reachable,
-            within_limits: reachable || !on_limit,
-            error,
-        }
+        None
     }
 
     /// The target relative to the HAA anchor, in the hip frame at q_HAA = 0 [m].
@@ -220,65 +326,35 @@ impl LegChain {
         mat_t_vec(&self.body_rot[0], sub(target, self.haa_anchor_base))
     }
 
-    /// The four solutions (2 HAA × 2 knee branches) of the limit-free chain,
-    /// most preferred first: HAA nearest its nominal angle, then the knee
-    /// branch `knee`. Every candidate is finite; out of reach they are only
-    /// approximate, which the caller detects from the foot error.
-    fn analytic_candidates(&self, target: Vec3, knee: f64) -> [Vec3; 4] {
-        let g = &self.ik_geometry;
-        let t = self.target_at_hip(target);
-        let (t_u, t_n, t_w) = (dot(t, g.u1), dot(t, g.n_perp), dot(t, g.w));
-        let v_w_abs = (t_n * t_n + t_w * t_w - g.lateral * g.lateral)
-            .max(0.0)
-            .sqrt();
-        let nominal_haa = self.nominal()[0];
-        let mut haa = [v_w_abs, -v_w_abs].map(|v_w| (v_w, t_w.atan2(t_n) - v_w.atan2(g.lateral)));
-        if wrap_angle(haa[0].1 - nominal_haa).abs() > wrap_angle(haa[1].1 - nominal_haa).abs() {
-            haa.swap(0, 1);
-        }
-        let mut out = [[0.0; 3]; 4];
-        for (i, &(v_w, q1)) in haa.iter().enumerate() {
-            // Where the foot must be in the hip frame once HAA has turned it into place.
-            let foot_hip = add(
-                self.params.anchor[0],
-                add(
-                    add(scale(g.u1, t_u), scale(g.n_perp, g.lateral)),
-                    scale(g.w, v_w),
-                ),
-            );
-            let rel = sub(foot_hip, g.hfe_anchor);
-            let (branches, _) = g.planar_branches([dot(rel, g.e1), dot(rel, g.e2)]);
-            let order = if knee > 0.0 { [0, 1] } else { [1, 0] };
-            for (j, b) in order.into_iter().enumerate() {
-                let (q2, phi) = branches[b];
-                out[2 * i + j] = [q1, q2, g.knee_axis_sign * phi];
-            }
-        }
-        out
-    }
-
     /// A few Newton steps from an analytic solution, to take out the error of
     /// a slightly imperfect axis structure or of acos near a straight knee.
-    fn polish(&self, q: Vec3, target: Vec3) -> (Vec3, f64) {
+    /// Returns the angles, the foot error [m] and the link frames at them.
+    fn polish(&self, q: Vec3, target: Vec3) -> (Vec3, f64, LinkFrames) {
         let (lower, upper) = (self.params.lower, self.params.upper);
-        let (mut q, mut foot_jac) = (q, self.fk_and_jacobian(q));
-        let mut error = norm(sub(foot_jac.0, target));
+        let fk = |q: Vec3| {
+            let f = self.link_frames(q);
+            let foot = add(f.pos[2], mat_vec(&f.rot[2], self.params.foot));
+            (foot, f)
+        };
+        let (mut q, (mut foot, mut frames)) = (q, fk(q));
+        let mut error = norm(sub(foot, target));
         for _ in 0..4 {
             if error <= 1e-14 {
                 break;
             }
-            let Some(dq) = solve(&foot_jac.1, sub(target, foot_jac.0)) else {
+            let jacobian = Self::columns(&frames, foot, 2);
+            let Some(dq) = solve(&jacobian, sub(target, foot)) else {
                 break;
             };
             let q_new = clamp_to(add(q, dq), lower, upper);
-            let fj = self.fk_and_jacobian(q_new);
-            let e_new = norm(sub(fj.0, target));
+            let (foot_new, frames_new) = fk(q_new);
+            let e_new = norm(sub(foot_new, target));
             if !e_new.is_finite() || e_new >= error {
                 break;
             }
-            (q, foot_jac, error) = (q_new, fj, e_new);
+            (q, foot, frames, error) = (q_new, foot_new, frames_new, e_new);
         }
-        (q, error)
+        (q, error, frames)
     }
 }
 
