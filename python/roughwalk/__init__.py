@@ -4,6 +4,7 @@ The public API is re-exported here; each wing (:mod:`roughwalk.terrain`, ...)
 has its own ``__init__`` with a fuller API.
 """
 
+from roughwalk import learning  # noqa: F401  (registers the ``learned`` initialiser)
 from roughwalk._core import __version__
 from roughwalk.errors import (
     ConfigError,

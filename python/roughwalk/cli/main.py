@@ -24,6 +24,7 @@ COMMAND_MODULES = [
     "roughwalk.cli.run_cmd",
     "roughwalk.cli.replay_cmd",
     "roughwalk.cli.track_cmd",
+    "roughwalk.cli.init_cmd",
 ]
 
 

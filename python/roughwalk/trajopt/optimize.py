@@ -109,6 +109,10 @@ class TrajoptProblem:
         lam_x = lam_g = None
         if warm_start is None:
             x0 = initializer.guess(nlp, resolved)
+            # A guess that comes with multipliers (the learned one) warm-starts IPOPT.
+            multipliers = getattr(initializer, "multipliers", None)
+            if multipliers is not None:
+                lam_x, lam_g = multipliers(nlp, resolved)
         else:
             if isinstance(warm_start, TrajoptResult):
                 lam_x, lam_g = warm_start.lam_x, warm_start.lam_g

@@ -1,0 +1,180 @@
+"""``roughwalk init generate|train|iterate``: learned initial guesses (Melon 2020, Alg. 1)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from roughwalk.cli.common import info
+
+__all__ = ["register"]
+
+DEFAULT_ROOT = Path(".experience")
+
+
+def _problem_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--env",
+        default="single_pallet",
+        help="environment: flat, single_pallet or double_pallet (default), or a terrain "
+        "spec with --goal",
+    )
+    p.add_argument("--goal", help="goal X,Y,YAW for a terrain that is not a named environment")
+    p.add_argument(
+        "--edge-x", type=float, help="x [m] of the obstacle's edge (starts 0.5–1.5 m before it)"
+    )
+    p.add_argument("--robot", default="anymal_c", help="a registered robot")
+    p.add_argument("--gait", default="walk", help="walk (default), trot, pace, bound, gallop")
+    p.add_argument("--steps", type=int, default=16, help="swings of all feet (default 16)")
+    p.add_argument("--duration", type=float, default=5.5, help="total duration [s] (default 5.5)")
+    p.add_argument(
+        "--optimize-durations", action="store_true", help="optimise the phase durations too"
+    )
+
+
+def _executor_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--executor", default="local", choices=("local", "ray"), help="where to solve")
+    p.add_argument("--address", help="Ray cluster address (with --executor ray)")
+    p.add_argument("--workers", type=int, default=1, help="local worker processes (default 1)")
+
+
+def register(sub: Any) -> None:
+    """Add the ``init`` command and its subcommands."""
+    p = sub.add_parser(
+        "init",
+        help="learned initial guesses: generate experience, train, iterate",
+        description="Melon et al.'s Algorithm 1: solve sampled tasks from the heuristic "
+        "guess (generate), learn task → solution (train), re-solve from the learned guess "
+        "and retrain (iterate).",
+    )
+    s = p.add_subparsers(dest="init_command", metavar="SUBCOMMAND")
+
+    g = s.add_parser("generate", help="solve sampled tasks and store the experience (resumable)")
+    _problem_args(g)
+    _executor_args(g)
+    g.add_argument("--tasks", type=int, default=2000, help="number of tasks (default 2000)")
+    g.add_argument("--split", default="train", choices=("train", "test"), help="task stream")
+    g.add_argument("--seed", type=int, default=0, help="task sampling seed")
+    g.add_argument("--max-iter", type=int, help="IPOPT iterations (default 100, N_h)")
+    g.add_argument("--init", default="heuristic", help="heuristic (default) or learned:MODEL")
+    g.add_argument("--out", type=Path, help="run folder (default .experience/ENV_GAITSTEPS_SPLIT)")
+    g.set_defaults(func=cmd_generate)
+
+    t = s.add_parser("train", help="filter a dataset and fit the learned initialiser")
+    t.add_argument("runs", nargs="+", type=Path, help="run folders or dataset .npz files")
+    t.add_argument("--out", type=Path, required=True, help="model file (.npz)")
+    t.add_argument("--layers", default="64,64", help="hidden layer sizes (default 64,64)")
+    t.add_argument("--g-max", type=float, help="cost threshold (default: start of the tail)")
+    t.add_argument("--seed", type=int, default=0, help="training seed")
+    t.add_argument("--max-epochs", type=int, default=500, help="L-BFGS iterations")
+    t.add_argument("--note", default="", help="text stored in the model header")
+    t.set_defaults(func=cmd_train)
+
+    it = s.add_parser(
+        "iterate", help="LearnedInit-1..K: re-solve from the model, re-filter, retrain"
+    )
+    it.add_argument("run", type=Path, help="the heuristic experience run folder")
+    it.add_argument("--rounds", type=int, default=3, help="LearnedInit rounds (default 3)")
+    it.add_argument("--tasks", type=int, help="re-solve only the first N tasks")
+    it.add_argument("--max-iter", type=int, default=25, help="N_θ (default 25)")
+    it.add_argument("--out", type=Path, required=True, help="folder for rounds and models")
+    it.add_argument("--g-max", type=float, help="cost threshold (default: start of the tail)")
+    it.add_argument("--seed", type=int, default=0, help="training seed")
+    _executor_args(it)
+    it.set_defaults(func=cmd_iterate)
+    p.set_defaults(func=lambda args: p.print_help() or 2)
+
+
+def _space(args: argparse.Namespace) -> Any:
+    from roughwalk.learning.task_space import ENVIRONMENTS, TaskSpace
+    from roughwalk.trajopt import parse_pose
+
+    if args.goal is None and args.edge_x is None and args.env in ENVIRONMENTS:
+        return ENVIRONMENTS[args.env]
+    if args.goal is None:
+        from roughwalk.errors import InvalidArgumentError
+
+        raise InvalidArgumentError(
+            f"--env {args.env!r} is not a named environment: give --goal X,Y,YAW "
+            f"(named: {', '.join(ENVIRONMENTS)})"
+        )
+    return TaskSpace.for_terrain(args.env, parse_pose(args.goal, "--goal"), edge_x=args.edge_x)
+
+
+def cmd_generate(args: argparse.Namespace) -> int:
+    """Solve ``--tasks`` sampled tasks into a resumable run folder."""
+    from roughwalk.learning.executors import make_executor
+    from roughwalk.learning.experience import N_HEURISTIC, generate
+    from roughwalk.learning.problem_spec import ProblemSpec
+
+    space = _space(args)
+    spec = ProblemSpec(
+        args.robot, space.terrain, args.gait, args.steps, args.duration, args.optimize_durations
+    )
+    out = args.out or DEFAULT_ROOT / f"{space.name}_{args.gait}{args.steps}_{args.split}"
+    model = None
+    max_iter = args.max_iter
+    if args.init != "heuristic":
+        from roughwalk.learning.initializer import model_for_spec
+
+        model = model_for_spec(args.init, spec)
+        max_iter = 25 if max_iter is None else max_iter
+    executor = make_executor(args.executor, workers=args.workers, address=args.address)
+    info(f"solving {args.tasks} {args.split} tasks of {space.name} into {out} ...")
+    data = generate(
+        spec,
+        space,
+        args.tasks,
+        out,
+        split=args.split,
+        seed=args.seed,
+        max_iter=N_HEURISTIC if max_iter is None else max_iter,
+        model=model,
+        init=args.init,
+        executor=executor,
+    )
+    solved = int(sum(s in ("exact", "approximate") for s in data["status"]))
+    print(f"{len(data)} tasks in {out / 'dataset.npz'}: {solved} converged")
+    return 0
+
+
+def cmd_train(args: argparse.Namespace) -> int:
+    """Filter the datasets and fit a model."""
+    from roughwalk.learning.training import load_datasets, train_model
+
+    data = load_datasets(args.runs)
+    layers = tuple(int(v) for v in str(args.layers).split(",") if v.strip())
+    model, report = train_model(
+        data,
+        layers=layers,
+        g_max=args.g_max,
+        seed=args.seed,
+        max_epochs=args.max_epochs,
+        note=args.note,
+    )
+    model.save(args.out)
+    print(report.summary())
+    info(f"wrote {args.out}")
+    return 0
+
+
+def cmd_iterate(args: argparse.Namespace) -> int:
+    """LearnedInit-1..K from a heuristic run."""
+    from roughwalk.learning.executors import make_executor
+    from roughwalk.learning.iterate import learned_init_rounds
+
+    executor = make_executor(args.executor, workers=args.workers, address=args.address)
+    rounds = learned_init_rounds(
+        args.run,
+        args.out,
+        rounds=args.rounds,
+        n_tasks=args.tasks,
+        max_iter=args.max_iter,
+        g_max=args.g_max,
+        seed=args.seed,
+        executor=executor,
+    )
+    for r in rounds:
+        print(r.summary())
+    return 0

@@ -1,0 +1,355 @@
+"""Experience generation: solve sampled tasks and keep every outcome (Melon 2020, Alg. 1).
+
+Y ← TOWR(A_h(X); N_h): each task of a task space is solved from an initial
+guess (the heuristic, or a learned model's) with an iteration limit, and the
+task, the guess, the solution vector, its cost, status, iterations and
+times are kept. A run writes each finished solve as its own small file
+(written to a temporary name, synced, then renamed), so a run killed at any
+moment loses no finished solve; running it again solves only what is
+missing, then consolidates everything into one :class:`Dataset`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, TextIO
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roughwalk.errors import ConfigError
+from roughwalk.learning.dataset import COLUMNS, Dataset
+from roughwalk.learning.executors import Executor, LocalExecutor
+from roughwalk.learning.problem_spec import ProblemSpec, build_problem, variable_layout
+from roughwalk.learning.task_space import TaskSpace
+from roughwalk.trajopt import (
+    ContactSchedule,
+    Formulation,
+    HeuristicInitializer,
+    Task,
+    TrajoptResult,
+)
+from roughwalk.trajopt.task import ResolvedTask, resolve
+
+if TYPE_CHECKING:
+    from roughwalk.learning.model_file import LearnedModel
+
+__all__ = [
+    "SolveJob",
+    "FixedGuess",
+    "solve_job",
+    "ExperienceRun",
+    "generate",
+    "result_row",
+    "read_run",
+]
+
+N_HEURISTIC = 100  # Melon 2020, §IV-B: N_h
+
+
+@dataclass(frozen=True)
+class SolveJob:
+    """One solve: task ``index`` of a split, from ``x0`` (None: the heuristic guess).
+
+    With multipliers ``lam_x0`` and ``lam_g0`` as well, IPOPT is warm-started.
+    """
+
+    spec: ProblemSpec
+    index: int
+    task: Task
+    max_iter: int
+    x0: NDArray[np.float64] | None = None
+    lam_x0: NDArray[np.float64] | None = None
+    lam_g0: NDArray[np.float64] | None = None
+
+
+class FixedGuess:
+    """An initialiser that hands over a given guess (and multipliers)."""
+
+    name = "fixed"
+
+    def __init__(
+        self,
+        x0: NDArray[np.float64],
+        lam_x0: NDArray[np.float64] | None = None,
+        lam_g0: NDArray[np.float64] | None = None,
+    ) -> None:
+        self.x0, self.lam_x0, self.lam_g0 = x0, lam_x0, lam_g0
+
+    def schedule(self, gait: ContactSchedule) -> ContactSchedule:
+        """The gait's schedule."""
+        return gait
+
+    def adjust_task(self, task: ResolvedTask) -> ResolvedTask:
+        """The task as given."""
+        return task
+
+    def guess(self, nlp: Formulation, task: ResolvedTask) -> NDArray[np.float64]:
+        """The given vector."""
+        return self.x0
+
+    def multipliers(
+        self, nlp: Formulation, task: ResolvedTask
+    ) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
+        """The given multipliers (None: IPOPT starts its own)."""
+        return self.lam_x0, self.lam_g0
+
+
+def result_row(index: int, result: TrajoptResult, x0: NDArray[np.float64]) -> dict[str, Any]:
+    """A dataset row (:data:`~roughwalk.learning.dataset.COLUMNS`) from a solve."""
+    assert result.task is not None and result.x is not None
+    history = result.history or []
+    solve_time = result.solve_time_s - result.build_time_s
+    first = float(history[1]["elapsed_s"]) if len(history) > 1 else solve_time
+    later = len(history) - 2
+    per_iteration = (float(history[-1]["elapsed_s"]) - first) / later if later > 0 else float("nan")
+    return {
+        "index": index,
+        "start": np.asarray(result.task.start, dtype=float),
+        "goal": np.asarray(result.task.goal, dtype=float),
+        "x0": np.asarray(x0, dtype=float),
+        "x": np.asarray(result.x, dtype=float),
+        "lam_x": np.asarray(result.lam_x, dtype=float),
+        "lam_g": np.asarray(result.lam_g, dtype=float),
+        "cost": float(result.objective),
+        "status": result.status.value,
+        "iterations": int(result.iterations),
+        "max_violation": float(result.max_violation),
+        "max_force_n": float(result.max_force_n),
+        "solve_time_s": float(solve_time),
+        "first_iteration_s": first,
+        "time_per_iteration_s": per_iteration,
+    }
+
+
+def solve_job(job: SolveJob) -> dict[str, Any]:
+    """Solve one job in this process (the NLP is built once per process)."""
+    problem = build_problem(job.spec)
+    if job.x0 is None:
+        resolved = resolve(job.task, problem.body, problem.terrain)
+        x0 = HeuristicInitializer().guess(problem.formulation, resolved)
+    else:
+        x0 = np.asarray(job.x0, dtype=float)
+    guess = FixedGuess(x0, job.lam_x0, job.lam_g0)
+    result = problem.solve(job.task, guess, max_iter=job.max_iter)
+    return result_row(job.index, result, x0)
+
+
+class ExperienceRun:
+    """A run's folder: ``run.json`` (what is solved), ``solves/`` (one file per task), dataset.
+
+    Parameters
+    ----------
+    folder:
+        The run's folder (created).
+    meta:
+        What the run solves: "problem", "task_space", "split", "seed",
+        "init", "max_iter" (and "layout", added on the first solve). A folder
+        made for other settings is refused, naming the first that differs.
+
+    """
+
+    def __init__(self, folder: str | Path, meta: dict[str, Any]) -> None:
+        self.folder = Path(folder)
+        self.solves = self.folder / "solves"
+        self.solves.mkdir(parents=True, exist_ok=True)
+        meta_path = self.folder / "run.json"
+        meta = json.loads(json.dumps(meta))  # tuples as JSON lists, as read back
+        if meta_path.is_file():
+            old = json.loads(meta_path.read_text())
+            for key, value in meta.items():
+                if key in old and old[key] != value:
+                    raise ConfigError(
+                        f"{self.folder} holds a run with another '{key}' "
+                        f"({old[key]!r}, asked {value!r}); use another folder"
+                    )
+            meta = {**old, **meta}
+        self.meta = meta
+        self._write_meta()
+
+    def _write_meta(self) -> None:
+        tmp = self.folder / "run.json.part"
+        tmp.write_text(json.dumps(self.meta, indent=1) + "\n")
+        os.replace(tmp, self.folder / "run.json")
+
+    def _path(self, index: int) -> Path:
+        return self.solves / f"{index:06d}.npz"
+
+    def done(self) -> set[int]:
+        """Indices of the finished solves."""
+        return {int(p.stem) for p in self.solves.glob("*.npz") if p.stem.isdigit()}
+
+    def record(self, row: dict[str, Any]) -> None:
+        """Store one finished solve durably (temporary file, fsync, rename)."""
+        path = self._path(int(row["index"]))
+        tmp = path.with_name(path.name + ".part")
+        with open(tmp, "wb") as f:
+            arrays: dict[str, Any] = {k: np.asarray(row[k]) for k in COLUMNS if k in row}
+            np.savez(f, **arrays)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+
+    def rows(self, indices: Sequence[int] | None = None) -> list[dict[str, Any]]:
+        """The stored rows (of ``indices``, default all), by index."""
+        wanted = sorted(self.done() if indices is None else indices)
+        out = []
+        for i in wanted:
+            with np.load(self._path(i), allow_pickle=False) as data:
+                out.append(_row(data))
+        return out
+
+    def dataset(self, indices: Sequence[int] | None = None) -> Dataset:
+        """The stored rows as a dataset, also written to ``dataset.npz`` (+ .json)."""
+        data = Dataset.from_rows(self.rows(indices), self.meta)
+        data.save(self.folder / "dataset.npz")
+        return data
+
+
+def _progress(done: int, total: int, new: int, started: float, out: TextIO) -> None:
+    elapsed = time.perf_counter() - started
+    width = 30
+    filled = int(width * done / max(total, 1))
+    rate = elapsed / new if new else float("nan")
+    eta = rate * (total - done)
+    line = (
+        f"[{'#' * filled}{'.' * (width - filled)}] {done}/{total} "
+        f"{rate:.1f} s/task, {eta / 60:.1f} min left"
+    )
+    if out.isatty():
+        out.write("\r" + line + ("\n" if done == total else ""))
+    elif done == total or done % max(total // 20, 1) == 0:
+        out.write(line + "\n")
+    out.flush()
+
+
+def generate(
+    spec: ProblemSpec,
+    space: TaskSpace,
+    n_tasks: int,
+    folder: str | Path,
+    *,
+    split: str = "train",
+    seed: int = 0,
+    max_iter: int = N_HEURISTIC,
+    model: LearnedModel | None = None,
+    init: str = "heuristic",
+    executor: Executor | None = None,
+    progress: TextIO | None = sys.stderr,
+    on_solved: Callable[[dict[str, Any]], None] | None = None,
+    indices: Sequence[int] | None = None,
+) -> Dataset:
+    """Solve tasks 0..n_tasks−1 of ``space``'s ``split`` into ``folder``; resume what is there.
+
+    Parameters
+    ----------
+    spec, space:
+        The problem and its task space.
+    n_tasks:
+        How many tasks (the first ``n_tasks`` of the split's stream).
+    folder:
+        The run's folder; finished solves found there are kept, not redone.
+    split, seed:
+        Which random stream of tasks.
+    max_iter:
+        IPOPT's iteration limit (N_h = 100 with the heuristic, N_θ = 25 learned).
+    model:
+        A learned model whose guesses (and multipliers) start the solves;
+        None uses the heuristic.
+    init:
+        The guesses' name, recorded in the run.
+    executor:
+        Where to solve (default: in this process).
+    progress:
+        Where to draw the progress bar (None: nowhere).
+    on_solved:
+        Called with each stored row (tests interrupt a run with it).
+    indices:
+        Solve these task indices instead of 0..n_tasks−1.
+
+    Returns
+    -------
+    Dataset
+        Every stored solve of the wanted tasks, sorted by task index.
+
+    """
+    if spec.terrain != space.terrain:
+        raise ConfigError(
+            f"the problem is on terrain '{spec.terrain}' but the task space "
+            f"'{space.name}' is on '{space.terrain}'"
+        )
+    run = ExperienceRun(
+        folder,
+        {
+            "problem": spec.to_dict(),
+            "task_space": space.to_dict(),
+            "split": split,
+            "seed": seed,
+            "init": init,
+            "max_iter": max_iter,
+        },
+    )
+    wanted = list(range(n_tasks)) if indices is None else sorted(set(indices))
+    done = run.done()
+    todo = [i for i in wanted if i not in done]
+    tasks = [space.task(i, seed=seed, split=split) for i in todo]
+    jobs = [SolveJob(spec, i, t, max_iter) for i, t in zip(todo, tasks, strict=True)]
+    if model is not None and tasks:
+        x0s = model.predict_tasks(tasks)
+        lam_x, lam_g = model.predict_multipliers(tasks)
+        jobs = [
+            SolveJob(
+                spec,
+                job.index,
+                job.task,
+                max_iter,
+                x0s[k],
+                None if lam_x is None else lam_x[k],
+                None if lam_g is None else lam_g[k],
+            )
+            for k, job in enumerate(jobs)
+        ]
+    if "layout" not in run.meta and jobs:
+        run.meta["layout"] = variable_layout(build_problem(spec).formulation)
+        run._write_meta()
+    started = time.perf_counter()
+    finished = len(wanted) - len(todo)
+    for row in (executor or LocalExecutor(1)).run(solve_job, jobs):
+        run.record(row)
+        finished += 1
+        if progress is not None:
+            _progress(finished, len(wanted), finished - len(wanted) + len(todo), started, progress)
+        if on_solved is not None:
+            on_solved(row)
+    if "layout" not in run.meta:
+        run.meta["layout"] = variable_layout(build_problem(spec).formulation)
+        run._write_meta()
+    run.meta["layout"] = [list(item) for item in run.meta["layout"]]
+    return run.dataset(wanted)
+
+
+def read_run(folder: str | Path) -> Dataset:
+    """The finished solves of a run folder (even one still running), without writing anything."""
+    path = Path(folder)
+    meta_path = path / "run.json"
+    if not meta_path.is_file():
+        raise ConfigError(f"{path} is not an experience run (no run.json)")
+    meta = json.loads(meta_path.read_text())
+    rows = []
+    for item in sorted((path / "solves").glob("*.npz")):
+        if not item.stem.isdigit():
+            continue
+        with np.load(item, allow_pickle=False) as data:
+            rows.append(_row(data))
+    return Dataset.from_rows(rows, meta)
+
+
+def _row(data: Any) -> dict[str, Any]:
+    """A stored row (rows from before multipliers were recorded lack them)."""
+    return {k: data[k][()] if data[k].ndim == 0 else data[k] for k in COLUMNS if k in data.files}

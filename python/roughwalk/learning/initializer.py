@@ -1,0 +1,120 @@
+"""The ``learned`` / ``learned:MODEL`` initialiser: A_θ's guess for the NLP (Melon 2020, §IV).
+
+``learned`` picks, among the models shipped in ``roughwalk/learning/models/``,
+the one trained for this problem's robot, terrain, gait, step count,
+duration and variable layout; ``learned:MODEL`` uses a model file (a path,
+or a shipped model's name) and refuses a problem it was not trained for.
+The contact schedule and the task are left as they are.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from roughwalk.errors import ConfigError
+from roughwalk.learning.model_file import LearnedModel, problem_signature
+from roughwalk.learning.problem_spec import ProblemSpec
+from roughwalk.trajopt import ContactSchedule, Formulation, register_initializer
+from roughwalk.trajopt.task import ResolvedTask
+
+__all__ = ["LearnedInitializer", "MODELS_DIR", "shipped_models", "load_model", "model_for_spec"]
+
+MODELS_DIR = Path(__file__).resolve().parent / "models"
+
+
+def shipped_models() -> list[Path]:
+    """The model files shipped with the package."""
+    return sorted(MODELS_DIR.glob("*.npz"))
+
+
+def load_model(name: str) -> LearnedModel:
+    """A model by path, or by the name of a shipped one ("anymal_c_single_pallet_walk16")."""
+    path = Path(name)
+    if path.is_file():
+        return LearnedModel.load(path)
+    shipped = MODELS_DIR / f"{name.removesuffix('.npz')}.npz"
+    if shipped.is_file():
+        return LearnedModel.load(shipped)
+    names = ", ".join(p.stem for p in shipped_models()) or "none"
+    raise ConfigError(f"no learned model {name!r} (not a file); shipped models: {names}")
+
+
+def _pick(signature: dict[str, object]) -> LearnedModel:
+    """The shipped model that fits ``signature``; say what is shipped if none does."""
+    models = [LearnedModel.load(p) for p in shipped_models()]
+    for model in models:
+        if not model.mismatches(signature):
+            return model
+    have = "; ".join(
+        f"{m.name} ({m.header['problem']['robot']}, {m.header['problem']['terrain']}, "
+        f"{m.header['problem']['gait']} {m.header['problem']['steps']} steps, "
+        f"{m.header['problem']['duration']} s)"
+        for m in models
+    )
+    raise ConfigError(
+        f"no shipped learned model fits robot {signature.get('robot')!r}, terrain "
+        f"{signature.get('terrain')!r}, gait {signature.get('gait')!r}, "
+        f"{signature.get('steps')} steps, {signature.get('duration')} s; shipped: "
+        f"{have or 'none'}; train one with `roughwalk init` and use learned:MODEL"
+    )
+
+
+def model_for_spec(init: str, spec: ProblemSpec) -> LearnedModel:
+    """The model named by ``init`` ("learned" or "learned:MODEL"), checked against ``spec``."""
+    name, _, argument = init.partition(":")
+    if name != "learned":
+        raise ConfigError(f"expected 'learned' or 'learned:MODEL', got {init!r}")
+    signature = {k: v for k, v in spec.to_dict().items()}
+    model = _pick(signature) if not argument else load_model(argument)
+    model.check_signature(signature)
+    return model
+
+
+class LearnedInitializer:
+    """A_θ's guess; registered as ``learned`` (shipped model) and ``learned:MODEL``.
+
+    Parameters
+    ----------
+    argument:
+        A model file or shipped model name; None picks the shipped model
+        that fits the problem when the guess is asked for.
+
+    """
+
+    name = "learned"
+
+    def __init__(self, argument: str | None = None) -> None:
+        self.model = load_model(argument) if argument else None
+
+    def schedule(self, gait: ContactSchedule) -> ContactSchedule:
+        """The gait's schedule (the model was trained for it)."""
+        return gait
+
+    def adjust_task(self, task: ResolvedTask) -> ResolvedTask:
+        """The task as given."""
+        return task
+
+    def guess(self, nlp: Formulation, task: ResolvedTask) -> NDArray[np.float64]:
+        """A_θ(task), within the NLP's variable bounds; refuses a problem the model does not fit."""
+        signature = problem_signature(nlp)
+        if self.model is None:
+            self.model = _pick(signature)
+        self.model.check_signature(signature)
+        return np.clip(self.model.predict(task.task), nlp.lbx, nlp.ubx)
+
+    def multipliers(
+        self, nlp: Formulation, task: ResolvedTask
+    ) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
+        """A_θ's multipliers (lam_x, lam_g) for IPOPT's warm start, or (None, None)."""
+        if self.model is None:
+            self.model = _pick(problem_signature(nlp))
+        lam_x, lam_g = self.model.predict_multipliers([task.task])
+        if lam_x is None or lam_g is None:
+            return None, None
+        return lam_x[0], lam_g[0]
+
+
+register_initializer("learned", LearnedInitializer)

@@ -1,0 +1,103 @@
+"""Experience datasets: npz + JSON round trip, and a killed run resumed gives the same dataset."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from roughwalk.errors import ConfigError, InvalidArgumentError
+from roughwalk.learning import Dataset, ProblemSpec, TaskSpace, generate
+from roughwalk.learning.dataset import COLUMNS
+from roughwalk.learning.experience import read_run
+
+SPEC = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0)
+SPACE = TaskSpace("flat_small", "flat", (-0.1, -0.1, -0.2), (0.1, 0.1, 0.2), (0.4, 0.0, 0.0))
+
+
+class Killed(Exception):
+    """Stands for the process being killed after some solves."""
+
+
+def test_task_sampling_is_seeded_extendable_and_held_out_apart() -> None:
+    first = SPACE.sample(5, seed=3)
+    assert SPACE.sample(8, seed=3)[:5] == first  # asking for more keeps the first ones
+    assert SPACE.sample(5, seed=4) != first
+    held_out = SPACE.sample(5, seed=3, split="test")
+    assert not {t.start for t in held_out} & {t.start for t in first}
+    starts = np.array([t.start for t in SPACE.sample(200)])
+    assert np.all(starts >= SPACE.start_low) and np.all(starts <= SPACE.start_high)
+    with pytest.raises(ConfigError, match="unknown split 'validation'"):
+        SPACE.task(0, split="validation")
+
+
+def test_dataset_round_trips_through_npz_and_json(tmp_path: Path) -> None:
+    rng = np.random.default_rng(0)
+    rows = [
+        {
+            "index": i,
+            "start": rng.normal(size=3),
+            "goal": rng.normal(size=3),
+            "x0": rng.normal(size=7),
+            "x": rng.normal(size=7),
+            "lam_x": rng.normal(size=7),
+            "lam_g": rng.normal(size=5),
+            "cost": float(rng.uniform()),
+            "status": ["exact", "iteration_limit"][i % 2],
+            "iterations": int(rng.integers(1, 100)),
+            "max_violation": float(rng.uniform()),
+            "max_force_n": 300.0,
+            "solve_time_s": 0.5,
+            "first_iteration_s": 0.1,
+            "time_per_iteration_s": float("nan"),
+        }
+        for i in (3, 0, 2, 1)
+    ]
+    meta = {"problem": SPEC.to_dict(), "layout": [["x", 7]], "split": "train", "seed": 0}
+    data = Dataset.from_rows(rows, meta)
+    assert data["index"].tolist() == [0, 1, 2, 3]
+    data.save(tmp_path / "d.npz")
+    back = Dataset.load(tmp_path / "d.npz")
+    assert back.same_rows(data, ignore=())
+    assert back.meta == json.loads(json.dumps(meta))
+    schema = json.loads((tmp_path / "d.json").read_text())
+    assert schema["version"] == 1 and set(schema["columns"]) == set(COLUMNS)
+    assert schema["columns"]["x"]["shape"] == [4, 7]
+    # Appending refuses overlapping tasks and other problems.
+    with pytest.raises(InvalidArgumentError, match="task indices are in both"):
+        data.append(back)
+    other = Dataset(back.columns, {**meta, "problem": {**SPEC.to_dict(), "steps": 8}})
+    with pytest.raises(InvalidArgumentError, match="differ in 'problem'"):
+        data.select(data["index"] < 2).append(other.select(other["index"] >= 2))
+    joined = data.select(data["index"] < 2).append(back.select(back["index"] >= 2))
+    assert joined.same_rows(data, ignore=())
+
+
+def test_killed_run_resumes_to_the_same_dataset(tmp_path: Path) -> None:
+    whole = generate(SPEC, SPACE, 4, tmp_path / "whole", progress=None)
+
+    def kill_after_two(row: dict[str, object]) -> None:
+        if int(row["index"]) == 1:  # type: ignore[call-overload]
+            raise Killed
+
+    with pytest.raises(Killed):
+        generate(SPEC, SPACE, 4, tmp_path / "resumed", progress=None, on_solved=kill_after_two)
+    # A half-written file from the moment of the kill is ignored.
+    (tmp_path / "resumed" / "solves" / "000002.npz.part").write_bytes(b"half")
+    assert len(read_run(tmp_path / "resumed")) == 2
+    seen: list[int] = []
+    resumed = generate(
+        SPEC,
+        SPACE,
+        4,
+        tmp_path / "resumed",
+        progress=None,
+        on_solved=lambda r: seen.append(r["index"]),
+    )
+    assert seen == [2, 3]  # the finished solves were not redone
+    assert resumed.same_rows(whole)
+    assert Dataset.load(tmp_path / "resumed" / "dataset.npz").same_rows(whole)
+    with pytest.raises(ConfigError, match="another 'seed'"):
+        generate(SPEC, SPACE, 4, tmp_path / "resumed", seed=1, progress=None)

@@ -1,0 +1,28 @@
+"""The Ray executor and the local pool give the same dataset for the same seed."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from roughwalk.learning import LocalExecutor, ProblemSpec, RayExecutor, TaskSpace, generate
+
+SPEC = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0)
+SPACE = TaskSpace("flat_small", "flat", (-0.1, -0.1, -0.2), (0.1, 0.1, 0.2), (0.4, 0.0, 0.0))
+
+
+def test_ray_and_local_pool_give_the_same_dataset(tmp_path: Path) -> None:
+    ray = pytest.importorskip("ray")
+    local = generate(
+        SPEC, SPACE, 3, tmp_path / "local", seed=7, progress=None, executor=LocalExecutor(1)
+    )
+    ray.init(num_cpus=1, include_dashboard=False, log_to_driver=False)
+    try:
+        remote = generate(
+            SPEC, SPACE, 3, tmp_path / "ray", seed=7, progress=None, executor=RayExecutor()
+        )
+    finally:
+        ray.shutdown()
+    assert len(remote) == 3
+    assert remote.same_rows(local)

@@ -1,0 +1,110 @@
+"""Model files: plain arrays + JSON header that reload exactly; a mismatched problem is refused."""
+
+from __future__ import annotations
+
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import roughwalk
+from roughwalk.errors import ConfigError
+from roughwalk.learning import LearnedModel, ProblemSpec, build_problem, filter_good
+from roughwalk.learning.dataset import Dataset
+from roughwalk.learning.filtering import cost_threshold
+from roughwalk.learning.mlp import MLP
+from roughwalk.learning.model_file import MODEL_FORMAT, problem_signature
+from roughwalk.trajopt import Task
+
+SPEC = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0)
+
+
+def _model(n_out: int, layout: list[list[object]], rng: np.random.Generator) -> LearnedModel:
+    weights = (
+        rng.normal(size=(6, 5)).astype(np.float32),
+        rng.normal(size=(5, n_out)).astype(np.float32),
+    )
+    biases = (rng.normal(size=5).astype(np.float32), rng.normal(size=n_out).astype(np.float32))
+    mlp = MLP(
+        weights, biases, "tanh", np.zeros(6), np.ones(6), rng.normal(size=n_out), np.ones(n_out)
+    )
+    header = {"format": MODEL_FORMAT, "version": 1, "problem": SPEC.to_dict(), "layout": layout}
+    return LearnedModel(mlp, header)
+
+
+def test_model_file_holds_arrays_only_and_predicts_the_same_after_reload(tmp_path: Path) -> None:
+    nlp = build_problem(SPEC).formulation
+    layout = problem_signature(nlp)["layout"]
+    model = _model(nlp.n_variables, layout, np.random.default_rng(1))
+    path = model.save(tmp_path / "m.npz")
+    with zipfile.ZipFile(path) as z:  # plain arrays: loadable without pickle
+        assert "header.npy" in z.namelist()
+    back = LearnedModel.load(path)
+    task = Task((0.1, -0.05, 0.2), (0.4, 0.0, 0.0))
+    # The forward pass against a hand-written one.
+    x = np.array([*task.start, *task.goal])
+    w0, w1 = model.mlp.weights
+    b0, b1 = model.mlp.biases
+    expected = model.mlp.out_mean + (np.tanh(x @ w0 + b0) @ w1 + b1)
+    np.testing.assert_allclose(back.predict(task), expected, rtol=1e-5)
+    back.check(nlp)  # the problem it was made for is accepted
+
+
+@pytest.mark.parametrize(
+    ("options", "named"),
+    [
+        ({"robot": "littledog"}, "robot is 'anymal_c' in the model but 'littledog' here"),
+        ({"gait": "trot"}, "gait is 'walk' in the model but 'trot' here"),
+        ({"steps": 8}, "steps is 4 in the model but 8 here"),
+    ],
+)
+def test_model_applied_to_another_robot_gait_or_step_count_is_refused(
+    tmp_path: Path, options: dict[str, object], named: str
+) -> None:
+    nlp = build_problem(SPEC).formulation
+    path = _model(nlp.n_variables, problem_signature(nlp)["layout"], np.random.default_rng(2)).save(
+        tmp_path / "walk4.npz"
+    )
+    problem = {"gait": "walk", "steps": 4, "duration": 2.0, **options}
+    robot = problem.pop("robot", "anymal_c")
+    with pytest.raises(ConfigError, match=f"learned model 'walk4' does not fit.*{named}"):
+        roughwalk.optimize_motion(
+            robot, "flat", ((0, 0, 0), (0.4, 0, 0)), init=f"learned:{path}", **problem
+        )
+
+
+def test_layout_change_alone_is_refused_naming_the_variable_sets() -> None:
+    nlp = build_problem(SPEC).formulation
+    layout = problem_signature(nlp)["layout"]
+    changed = [[name, size + 1 if name == "base_lin" else size] for name, size in layout]
+    model = _model(nlp.n_variables, changed, np.random.default_rng(3))
+    with pytest.raises(ConfigError, match="variable layout differs in base_lin"):
+        model.check(nlp)
+
+
+def test_g_max_is_found_at_the_start_of_the_tail() -> None:
+    rng = np.random.default_rng(0)
+    body = np.exp(rng.normal(0.0, 0.1, size=200))  # costs around 1
+    tail = np.array([5.0, 20.0, 300.0, 1e4])  # poor local minima
+    g_max = cost_threshold(np.concatenate([body, tail]))
+    assert body.max() < g_max < tail.min()
+    n = len(body) + len(tail)
+    columns = {
+        "index": np.arange(n),
+        "start": np.zeros((n, 3)),
+        "goal": np.zeros((n, 3)),
+        "x0": np.zeros((n, 1)),
+        "x": np.zeros((n, 1)),
+        "cost": np.concatenate([body, tail]),
+        "status": np.array(["exact"] * n),
+        "iterations": np.zeros(n, int),
+        "max_violation": np.where(np.arange(n) == 0, 1.0, 0.0),  # one infeasible
+        "max_force_n": np.zeros(n),
+        "solve_time_s": np.zeros(n),
+        "first_iteration_s": np.zeros(n),
+        "time_per_iteration_s": np.zeros(n),
+    }
+    result = filter_good(Dataset(columns, {}))
+    assert result.automatic and result.n_good == len(body) - 1
+    assert filter_good(Dataset(columns, {}), g_max=10.0).n_good == len(body) - 1 + 1
