@@ -392,3 +392,13 @@ class SwingPassEvaluator:
     ) -> None: ...
     def evaluate(self, xi: ArrayLike) -> dict[str, Any]:
         """Terms, gradient (n, 3), the leg's clearances and points at ξ (n, 3) [rad]."""
+
+def center_of_mass_batch(
+    quadruped: Quadruped,
+    q: ArrayLike,
+    link_mass: ArrayLike,
+    link_com: ArrayLike,
+    base_mass: float,
+    base_com: ArrayLike,
+) -> NDArray[np.float64]:
+    """Whole-robot CoM (N, 3) in the base frame [m] for joint angles (N, 4, 3) [rad]."""

@@ -146,3 +146,17 @@ def test_backend_choice() -> None:
         resolve_backend("rust", FakeField())
     with pytest.raises(InvalidArgumentError, match="known: auto, rust, python"):
         resolve_backend("numba", FakeField())
+
+
+def test_batched_com_and_feet_equal_the_numpy_link_frames(barrier) -> None:
+    gen, state = barrier
+    wb = gen.wb
+    rng = np.random.default_rng(5)
+    q = state.q + 0.2 * rng.normal(size=state.q.shape)
+    frames = wb.link_frames(q)
+    np.testing.assert_allclose(
+        wb.center_of_mass(q), wb.center_of_mass(q, frames), rtol=0, atol=1e-12
+    )
+    np.testing.assert_allclose(
+        wb.foot_positions(q), wb.foot_positions(q, frames), rtol=0, atol=1e-12
+    )

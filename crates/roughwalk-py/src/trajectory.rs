@@ -9,7 +9,8 @@ use roughwalk_core::kinematics::math::{Mat3, Vec3};
 use roughwalk_core::trajectory::body_pass::BodyPassSetup;
 use roughwalk_core::trajectory::swing_pass::SwingPassSetup;
 use roughwalk_core::trajectory::{
-    BodyPass, BodyPoints, GradientMode, ObstacleTerm, SwingPass, ZmpSupport,
+    center_of_mass_batch, BodyPass, BodyPoints, GradientMode, MassDistribution, ObstacleTerm,
+    SwingPass, ZmpSupport,
 };
 use roughwalk_core::CoreError;
 
@@ -340,9 +341,44 @@ impl PySwingPassEvaluator {
     }
 }
 
-/// Adds the pass evaluators to the module.
+/// Whole-robot CoM (N, 3) in the base frame [m] for joint angles (N, 4, 3) [rad],
+/// from link masses (4, 3) [kg], link CoMs (4, 3, 3) in their link frames [m]
+/// and the trunk's mass [kg] and CoM (3,) [m].
+#[pyfunction]
+#[pyo3(name = "center_of_mass_batch")]
+fn center_of_mass_batch_py<'py>(
+    py: Python<'py>,
+    quadruped: PyRef<'py, PyQuadruped>,
+    q: ArrayIn<'py>,
+    link_mass: ArrayIn<'py>,
+    link_com: ArrayIn<'py>,
+    base_mass: f64,
+    base_com: ArrayIn<'py>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let q = rows::<12>(&read(&q, "q", &[None, Some(4), Some(3)])?);
+    let lm = read(&link_mass, "link_mass", &[Some(4), Some(3)])?;
+    let lc = read(&link_com, "link_com", &[Some(4), Some(3), Some(3)])?;
+    let bc = read(&base_com, "base_com", &[Some(3)])?;
+    let mass = MassDistribution {
+        link_mass: std::array::from_fn(|l| [lm[3 * l], lm[3 * l + 1], lm[3 * l + 2]]),
+        link_com: std::array::from_fn(|l| {
+            std::array::from_fn(|k| {
+                let i = 9 * l + 3 * k;
+                [lc[i], lc[i + 1], lc[i + 2]]
+            })
+        }),
+        base_mass,
+        base_com: [bc[0], bc[1], bc[2]],
+    };
+    let robot = &quadruped.inner;
+    let com = py.detach(|| center_of_mass_batch(robot, &mass, &q)).py()?;
+    array(py, com.concat(), &[q.len(), 3])
+}
+
+/// Adds the pass evaluators and the CoM batch to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBodyPassEvaluator>()?;
     m.add_class::<PySwingPassEvaluator>()?;
+    m.add_function(wrap_pyfunction!(center_of_mass_batch_py, m)?)?;
     Ok(())
 }

@@ -229,6 +229,8 @@ class BodyPass:
         body[1:-1] = xi
         rot = rpy_to_matrix(body[:, 3:])
         feet_b = np.einsum("tji,tlj->tli", rot, s.feet - body[:, None, :3])
+        # A lifted leg keeps its angles: spare IK its (maybe unreachable) target.
+        feet_b = np.where(s.support[..., None], feet_b, self.wb.nominal_feet[None])
         q_ik, reached = self.wb.inverse_kinematics(feet_b)
         q = np.where(s.support[..., None], q_ik, self.held_q)
         reached = reached | ~s.support

@@ -161,6 +161,8 @@ def resample_footstep(
     feet = np.repeat(state.step.stance_before[None], n + 1, axis=0)
     feet[time >= t_touch - 1e-9, leg] = state.step.target
     feet_b = np.einsum("tji,tlj->tli", rot, feet - body[:, None, :3])
+    # The lifted leg's angles come from its own spline below.
+    feet_b[airborne, leg] = wb.nominal_feet[leg]
     q, reached = wb.inverse_kinematics(feet_b)
     window = slice(state.lift_off, state.touchdown + 1)
     swing_times = state.times[window]

@@ -151,10 +151,13 @@ class WholeBody:
         hi = np.where(np.isfinite(self.upper), self.upper, np.pi)
         samples = lo[None] + grid[:, None, :] * (hi - lo)[None]
         hips = np.asarray(robot.hip_positions)
-        self.max_reach = np.linalg.norm(self.foot_positions(samples) - hips[None], axis=-1).max(
-            axis=0
-        )
+        feet = self.foot_positions(samples, self.link_frames(samples))
+        self.max_reach = np.linalg.norm(feet - hips[None], axis=-1).max(axis=0)
         """(4,) the farthest each foot gets from its hip (HAA anchor) [m]."""
+        self.nominal_feet = np.asarray(robot.nominal_stance.feet, dtype=float)
+        """(4, 3) feet in the base frame at the nominal joint angles [m]: an IK
+        target that is always reached, for legs whose solution is not used
+        (an unreachable one costs IK a search for the closest foot)."""
         d = robot.description
         self._link_mass = np.asarray(d.link_mass, dtype=float)
         self._link_com = np.asarray(d.link_com, dtype=float)
@@ -229,7 +232,10 @@ class WholeBody:
 
     def foot_positions(self, q: ArrayLike, frames: Frames | None = None) -> NDArray[np.float64]:
         """Foot centres (N, 4, 3) in the base frame [m] for joint angles q (N, 4, 3)."""
-        positions, rotations, _, _ = self.link_frames(q) if frames is None else frames
+        if frames is None:
+            rows = np.ascontiguousarray(np.asarray(q, dtype=float).reshape(-1, 12))
+            return np.asarray(self._core.fk_batch(rows)).reshape(-1, 4, 3)
+        positions, rotations, _, _ = frames
         return positions[:, :, 2] + np.einsum("nlij,lj->nli", rotations[:, :, 2], self._foot)
 
     def foot_jacobians(self, q: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -253,7 +259,16 @@ class WholeBody:
 
     def center_of_mass(self, q: ArrayLike, frames: Frames | None = None) -> NDArray[np.float64]:
         """Whole-robot centre of mass (N, 3) in the base frame [m] for q (N, 4, 3)."""
-        positions, rotations, _, _ = self.link_frames(q) if frames is None else frames
+        if frames is None:
+            return _core.center_of_mass_batch(
+                self._core,
+                np.asarray(q, dtype=float).reshape(-1, 4, 3),
+                self._link_mass,
+                self._link_com,
+                self._base_mass,
+                self._base_com,
+            )
+        positions, rotations, _, _ = frames
         coms = positions + np.einsum("nlkij,lkj->nlki", rotations, self._link_com)
         weighted = np.einsum("nlki,lk->ni", coms, self._link_mass)
         return (weighted + self._base_mass * self._base_com) / self.mass

@@ -11,6 +11,7 @@
 
 pub mod body_pass;
 pub mod body_points;
+pub mod center_of_mass;
 pub mod obstacle;
 pub mod rpy;
 pub mod swing_pass;
@@ -18,6 +19,7 @@ pub mod zmp_support;
 
 pub use body_pass::{BodyPass, BodyPassEvaluation};
 pub use body_points::BodyPoints;
+pub use center_of_mass::{center_of_mass_batch, MassDistribution};
 pub use obstacle::{obstacle_potential, DistanceQuery, GradientMode, ObstacleTerm};
 pub use swing_pass::{SwingPass, SwingPassEvaluation};
 pub use zmp_support::{polygon_margin, ZmpSupport};
