@@ -255,6 +255,12 @@ SMALL = {"config": towr_config(), "gait": "walk", "steps": 4, "duration": 2.0}
             {"duration": 0.5, "config": towr_config(optimize_durations=True)},
             "too short",
         ),
+        (
+            "flat",
+            ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)),
+            {"duration": 9.0, "config": towr_config(optimize_durations=True)},
+            "too long",
+        ),
     ],
 )
 def test_bad_tasks_get_a_clear_status(terrain: str, task: tuple, options: dict, match: str) -> None:

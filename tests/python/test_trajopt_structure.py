@@ -95,6 +95,28 @@ def test_trot_makes_towrs_14_steps_and_any_even_count() -> None:
     assert sixteen.durations[1] == pytest.approx((0.3, 0.5, 0.4, 0.6, 0.4, 0.6, 0.4, 0.6, 0.8))
 
 
+def test_fitted_schedule_keeps_totals_and_moves_phases_into_bounds() -> None:
+    # 5.5 s of a 16-step walk has stances over 1.0 s and, at 3.5 s, swings
+    # under 0.2 s: outside TOWR's duration bounds.
+    for duration in (3.5, 5.5):
+        nominal = make_gait("walk", 16, duration)
+        fitted = nominal.fitted((0.2, 1.0))
+        assert fitted.in_contact_at_start == nominal.in_contact_at_start
+        for before, after in zip(nominal.durations, fitted.durations, strict=True):
+            assert sum(after) == pytest.approx(sum(before), abs=1e-12)
+            assert min(after) >= 0.2 - 1e-12 and max(after) <= 1.0 + 1e-12
+            # The phases that were not clamped share the difference in proportion.
+            kept = [0.2 < b < 1.0 and 0.2 < a < 1.0 for a, b in zip(after, before, strict=True)]
+            ratios = np.array(after)[kept] / np.array(before)[kept]
+            assert ratios.size and np.ptp(ratios) < 1e-9
+    within = make_gait("walk", 16, 4.0).fitted((0.1, 2.0))
+    assert within.durations == make_gait("walk", 16, 4.0).durations
+    # A foot whose phases cannot fit is left alone (the caller reports it).
+    assert make_gait("walk", 4, 9.0).fitted((0.2, 1.0)).durations == (
+        make_gait("walk", 4, 9.0).durations
+    )
+
+
 def test_bad_gaits_are_refused_by_name() -> None:
     with pytest.raises(InvalidArgumentError, match="walk gait cannot make 14 steps.*4, 8, 12"):
         make_gait("walk", 14, 3.0)
@@ -184,17 +206,21 @@ def test_hermite_point_matches_its_definition() -> None:
 
 def test_initialisers_by_name_and_the_learned_plug_in_point() -> None:
     from roughwalk.trajopt import initializer_names, make_initializer, register_initializer
+    from roughwalk.trajopt.initializers import registry
 
     assert {"heuristic", "footsteps"} <= set(initializer_names())
     assert isinstance(make_initializer("heuristic"), HeuristicInitializer)
-    with pytest.raises(ConfigError, match="registered by roughwalk.learning"):
-        make_initializer("learned")
-    with pytest.raises(InvalidArgumentError, match="does not exist"):
-        make_initializer("footsteps:/no/such/plan.json")
-    register_initializer("learned", lambda argument: HeuristicInitializer(argument))
+    # The learning wing registers "learned" when it is imported; without it
+    # the plug-in point names its provider.
+    learned = registry._REGISTRY.pop("learned", None)
     try:
+        with pytest.raises(ConfigError, match="registered by roughwalk.learning"):
+            make_initializer("learned")
+        with pytest.raises(InvalidArgumentError, match="does not exist"):
+            make_initializer("footsteps:/no/such/plan.json")
+        register_initializer("learned", lambda argument: HeuristicInitializer(argument))
         assert isinstance(make_initializer("learned"), HeuristicInitializer)
     finally:
-        from roughwalk.trajopt.initializers import registry
-
-        registry._REGISTRY.pop("learned")
+        registry._REGISTRY.pop("learned", None)
+        if learned is not None:
+            registry._REGISTRY["learned"] = learned

@@ -104,6 +104,9 @@ class Formulation:
         schedule: ContactSchedule,
         terrain: TerrainModel,
     ) -> None:
+        if config.optimize_durations:
+            # Optimised durations start inside their bounds (see ContactSchedule.fitted).
+            schedule = schedule.fitted(config.phase_duration_bounds)
         self.config = config
         self.body = body
         self.schedule = schedule

@@ -188,6 +188,35 @@ class ContactSchedule:
             self.in_contact_at_start,
         )
 
+    def fitted(self, bounds: tuple[float, float]) -> ContactSchedule:
+        """The same schedule with every phase moved into ``bounds`` = (min, max) [s].
+
+        Each foot's phases keep their total: phases outside the bounds are
+        clamped, and the difference is shared by the others in proportion to
+        their length. Optimised durations start here: a nominal phase outside
+        its bounds would be clamped by IPOPT alone, and the polynomials would
+        then no longer hold the times the initial guess put them at. A foot
+        whose phases cannot fit (too many or too few for the duration) is
+        left as it is; callers check that case themselves.
+        """
+        lo, hi = bounds
+        fitted = []
+        for durations in self.durations:
+            d = np.asarray(durations, dtype=float)
+            total = float(d.sum())
+            if not len(d) * lo <= total <= len(d) * hi:
+                fitted.append(tuple(float(v) for v in d))
+                continue
+            for _ in range(len(d) + 1):
+                d = np.clip(d, lo, hi)
+                excess = total - float(d.sum())
+                if abs(excess) < 1e-12:
+                    break
+                free = d < hi if excess > 0 else d > lo
+                d[free] += excess * d[free] / d[free].sum()
+            fitted.append(tuple(float(v) for v in d))
+        return self.with_durations(fitted)
+
     def structure_key(self) -> tuple[object, ...]:
         """What fixes the NLP's structure: phase counts and first contacts (not durations)."""
         return (tuple(len(d) for d in self.durations), self.in_contact_at_start)

@@ -259,13 +259,20 @@ def _invalid(
 
 def _schedule_problems(schedule: ContactSchedule, cfg: TrajoptConfig) -> list[str]:
     out = []
-    lo = cfg.phase_duration_bounds[0]
+    lo, hi = cfg.phase_duration_bounds
     for foot, durations in enumerate(schedule.durations):
         if cfg.optimize_durations and len(durations) * lo > schedule.total_duration + 1e-9:
             out.append(
                 f"duration {schedule.total_duration:g} s is too short for {schedule.steps} steps: "
                 f"foot {foot}'s {len(durations)} phases need at least {len(durations) * lo:g} s "
                 f"at {lo:g} s each"
+            )
+            break
+        if cfg.optimize_durations and len(durations) * hi < schedule.total_duration - 1e-9:
+            out.append(
+                f"duration {schedule.total_duration:g} s is too long for {schedule.steps} steps: "
+                f"foot {foot}'s {len(durations)} phases last at most {len(durations) * hi:g} s "
+                f"at {hi:g} s each"
             )
             break
         if not cfg.optimize_durations and min(durations) < _MIN_FIXED_PHASE:
