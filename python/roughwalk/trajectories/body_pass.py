@@ -35,6 +35,7 @@ from roughwalk.trajectories.whole_body import WholeBody
 
 __all__ = [
     "BACKENDS",
+    "DAMPING",
     "BodyPass",
     "clearance_ok",
     "compiled_field",
@@ -48,8 +49,8 @@ __all__ = [
 # elsewhere, so CHOMP stops only with that much to spare [m].
 _ZMP_GUARD = 0.001
 
-# μ of the damped J_fB⁻¹ in the trunk pass's point Jacobians [m/rad].
-_DAMPING = 1e-3
+DAMPING = 1e-3
+"""μ of the damped J_fB⁻¹ in the trunk pass's point Jacobians [m/rad]."""
 
 BACKENDS = ("auto", "rust", "python")
 
@@ -132,6 +133,10 @@ class BodyPass:
         penalises (default: the state's current one).
     backend:
         ``"auto"``, ``"rust"`` or ``"python"`` (module docstring).
+    damping:
+        μ [m/rad] of the damped J_fB⁻¹ that carries the supporting legs'
+        points with the trunk (a straight leg must not blow it up); the
+        gradient is exact as μ → 0.
     """
 
     def __init__(
@@ -144,8 +149,10 @@ class BodyPass:
         gravity: float = 9.81,
         reference: NDArray[np.float64] | None = None,
         backend: str = "auto",
+        damping: float = DAMPING,
     ) -> None:
         self.wb = wb
+        self.damping = float(damping)
         self.state = state
         self.obstacle = obstacle
         self.config = config
@@ -211,7 +218,7 @@ class BodyPass:
                 dt=state.dt,
                 reach_margin=config.reach_margin,
                 reach_weight=config.reachability_weight * self.h,
-                damping=_DAMPING,
+                damping=self.damping,
                 zmp_k=state.com_height / gravity,
                 zmp_margin=config.zmp_margin,
                 support_weight=config.support_weight * self.h,
@@ -319,7 +326,7 @@ class BodyPass:
         obs = self.obstacle.evaluate(points, self.active)
         ti, ui = ObstacleCost.gradient_pairs(obs.workspace_gradient)
         jac = wb.body_pass_jacobians_at(
-            q, frames, p_b, feet_b, rot, body[:, 3:], s.support, ti + 1, ui
+            q, frames, p_b, feet_b, rot, body[:, 3:], s.support, ti + 1, ui, self.damping
         )
         n = body.shape[0] - 2
         grad = ObstacleCost.to_coordinates(obs.workspace_gradient, jac, ti, ui, n)

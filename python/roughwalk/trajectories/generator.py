@@ -53,6 +53,11 @@ if TYPE_CHECKING:
 
 __all__ = ["FootstepTrajectoryGenerator", "OptimizationOutcome", "PreparedPlan"]
 
+EXIT_MARGIN_FACTOR = 2.0
+"""Where each swing leaves the ZMP, in multiples of the support term's margin inside
+its triangle: the preview controller lags its reference, and the ZMP must still be
+inside when the foot lands."""
+
 
 @dataclass(frozen=True)
 class PreparedPlan:
@@ -302,8 +307,11 @@ class FootstepTrajectoryGenerator:
         if last == n_steps:
             points.append(anchors[n_steps + 1])
         # Each swing moves the ZMP toward the next anchor, as far as its triangle
-        # allows with the margin the support term asks for.
-        margin = self.config.chomp.zmp_margin
+        # allows with twice the margin the support term asks for: with the
+        # support term's own margin, the ZMP ended up to 1.6 mm outside the
+        # triangle just before touchdown on LittleDog board AD, where the trunk
+        # is held and CHOMP cannot pull it back.
+        margin = EXIT_MARGIN_FACTOR * self.config.chomp.zmp_margin
         steps = prepared.sequence.steps
         exits = [
             closest_point_in_triangle(points[j + 2], steps[k + j].support_triangle, margin)

@@ -32,7 +32,6 @@ from roughwalk.robots.canonical_frame import LEG_NAMES
 from roughwalk.trajectories.body_keyframes import (
     BodyKeyframe,
     keyframe_at,
-    nominal_fit,
     pose_over_support,
     rpy_of,
 )
@@ -281,8 +280,8 @@ class StepSequence:
             pos, rpy = _pose(init, "initial_pose")
             initial = keyframe_at(wb, stance, pos, rpy)
         else:
-            base, rpy = nominal_fit(wb, stance)
-            initial = keyframe_at(wb, stance, base, rpy)
+            # The fitted pose alone may hang the CoM outside the feet on a slope.
+            initial = pose_over_support(wb, stance, [0, 1, 2, 3], support_margin)
         moves = [
             (
                 leg,
