@@ -4,7 +4,7 @@ Start with :func:`run` (a robot, a terrain, a start and a goal in; a
 :class:`RunResult` out). The pieces are usable alone: :class:`World` (robot
 + terrain in one MuJoCo model), :class:`Runner` (servo commands at the
 control rate), :class:`TrajectoryBuffer`, :class:`JointController`,
-:class:`LegIntegrator`, :class:`ReflexMonitor`, :class:`Executor`,
+:class:`LegIntegrator`, :class:`CopStabilizer`, :class:`ReflexMonitor`, :class:`Executor`,
 :class:`OutcomeMonitor`, :class:`RunLog` and the disturbances.
 """
 
@@ -16,8 +16,10 @@ from roughwalk.sim.config import (
     OutcomeConfig,
     ReflexConfig,
     SimConfig,
+    StabilizerConfig,
     WorldConfig,
 )
+from roughwalk.sim.cop_stabilizer import CopStabilizer, centre_of_pressure
 from roughwalk.sim.disturbances import FrictionDrop, MapError, Push, parse_disturbance
 from roughwalk.sim.executor import Executor
 from roughwalk.sim.footstep_source import (
@@ -48,6 +50,7 @@ __all__ = [
     "ContactConfig",
     "ControllerConfig",
     "IntegratorConfig",
+    "StabilizerConfig",
     "ReflexConfig",
     "OutcomeConfig",
     "ExecutorConfig",
@@ -61,6 +64,8 @@ __all__ = [
     "DesiredState",
     "JointController",
     "LegIntegrator",
+    "CopStabilizer",
+    "centre_of_pressure",
     "ReflexMonitor",
     "ReflexTrigger",
     "Executor",

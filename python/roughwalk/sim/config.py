@@ -17,6 +17,7 @@ __all__ = [
     "ContactConfig",
     "ControllerConfig",
     "IntegratorConfig",
+    "StabilizerConfig",
     "ReflexConfig",
     "OutcomeConfig",
     "ExecutorConfig",
@@ -206,6 +207,53 @@ class IntegratorConfig:
 
 
 @dataclass(frozen=True)
+class StabilizerConfig:
+    """The CoP stabiliser: the trunk shifts to bring the measured CoP onto the planned ZMP.
+
+    Attributes
+    ----------
+    enabled:
+        Run the stabiliser at all.
+    estimate_s:
+        Time constant [s] of the low-pass that estimates the CoP offset the
+        plan does not explain (foot impacts last a few milliseconds, a rock
+        settling under a foot a few tenths of a second). Shorter reacts
+        faster and lets more of the footfalls' noise move the trunk.
+    follow_s:
+        1/ω [s] of the critically damped motion by which the trunk shift
+        follows the estimate. Shorter moves the trunk harder, and a trunk
+        accelerating sideways moves its own ZMP the other way.
+    max_shift_m:
+        Largest trunk shift |s| [m]; beyond it the error is the reflexes' business.
+    leak_s:
+        Time constant [s] with which the shift fades while nothing is
+        measured (all feet unloaded, or a reflex's recovery).
+    min_load_n:
+        Total vertical foot force [N] below which the CoP is not read.
+    min_foot_n:
+        A foot bears load above this vertical force [N]. The CoP is read
+        only while exactly the planned supporting feet do.
+    holdoff_s:
+        After the contacts last differed from the plan (a foot strike, a
+        touchdown early or late, a foot letting go), wait this long [s] before
+        reading the CoP again, so the transient is not taken for an offset.
+    """
+
+    enabled: bool = True
+    estimate_s: float = 0.15
+    follow_s: float = 0.1
+    max_shift_m: float = 0.02
+    leak_s: float = 1.0
+    min_load_n: float = 5.0
+    min_foot_n: float = 0.5
+    holdoff_s: float = 0.15
+
+    def __post_init__(self) -> None:
+        _nonnegative(self, ("min_load_n", "min_foot_n", "holdoff_s"), "stabilizer")
+        _positive(self, ("estimate_s", "follow_s", "max_shift_m", "leak_s"), "stabilizer")
+
+
+@dataclass(frozen=True)
 class ReflexConfig:
     """Errors that trigger the reflex, and what it does (Zucker 2011, §6 and §4.5).
 
@@ -342,6 +390,7 @@ class SimConfig:
     world: WorldConfig = field(default_factory=WorldConfig)
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     integrator: IntegratorConfig = field(default_factory=IntegratorConfig)
+    stabilizer: StabilizerConfig = field(default_factory=StabilizerConfig)
     reflex: ReflexConfig = field(default_factory=ReflexConfig)
     outcome: OutcomeConfig = field(default_factory=OutcomeConfig)
     executor: ExecutorConfig = field(default_factory=ExecutorConfig)

@@ -31,6 +31,7 @@ import numpy as np
 from roughwalk.errors import PlanningError
 from roughwalk.robots.canonical_frame import LEG_NAMES
 from roughwalk.sim.config import SimConfig
+from roughwalk.sim.cop_stabilizer import CopStabilizer
 from roughwalk.sim.footstep_source import FootstepSource, PlanAttempt, PlanStart
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
@@ -57,6 +58,9 @@ ProgressCallback = Callable[[float, float, str], None]
 """Called every simulated tenth of a second with (sim time [s], progress 0–1, mode)."""
 
 _SETTLE_BEFORE_S = 0.3
+# How far [m] a foot may have settled from its planned foothold for a re-plan
+# to start from the planned one.
+_NEAR_PLAN_M = 0.025
 
 
 class _Plan:
@@ -116,6 +120,7 @@ class Executor:
         self.runner = Runner(self.world)
         self.controller = JointController(self.world, self.config.controller)
         self.integrator = LegIntegrator(robot, self.config.integrator, self.world.control_dt)
+        self.stabilizer = CopStabilizer(self.config.stabilizer, self.world.control_dt)
         self.reflexes = ReflexMonitor(self.config.reflex)
         self.generator = FootstepTrajectoryGenerator(
             robot, self.planner_terrain, sdf=sdf, config=trajectory_config
@@ -258,8 +263,11 @@ class Executor:
                 wait_s += dt
             if mode == "replan":
                 replan_s += dt
+            # The trunk's target moved by the CoP stabiliser's shift: what the
+            # integrators hold and the reflexes judge.
+            steered = self.stabilizer.update(desired, measured)
             if mode in ("walk", "wait") and monitor.first_motion is not None:
-                trigger = self.reflexes.check(desired, measured)
+                trigger = self.reflexes.check(steered, measured)
                 if trigger is not None:
                     reflexes += 1
                     log.event(
@@ -275,8 +283,9 @@ class Executor:
                         failure = f"gave up after {cfg.reflex.max_reflexes} reflexes"
                         break
                     desired = self._start_recovery(measured, desired, now)
+                    steered = desired
                     mode = "recovery"
-            q_cmd = self.integrator.update(desired, measured)
+            q_cmd = self.integrator.update(steered, measured, self.stabilizer.feet_offset(desired))
             if desired.kind == "recovery":
                 q_cmd = self._catch(q_cmd, desired, measured)
             command = self.controller.command(q_cmd, desired, measured)
@@ -379,10 +388,12 @@ class Executor:
         current = self.buffer.current
         planned = current.last().feet if current is not None else desired.feet
         self._reflex_next_leg = self._next_leg(desired)
+        self._reflex_planned_feet = np.array(planned, dtype=float)
         in_contact = measured.foot_forces[:, 2] > 1.0
         self._plan = None
         self.buffer.clear()
         self.integrator.reset()
+        self.stabilizer.reset()
         self.reflexes.reset()
         segments, footholds = recovery_segment(
             self.robot,
@@ -434,6 +445,20 @@ class Executor:
             feet=measured.feet.copy(), next_leg=getattr(self, "_reflex_next_leg", None)
         )
         plan, attempt, wall = self._make_plan(start, goal, budget)
+        planned = getattr(self, "_reflex_planned_feet", None)
+        if (
+            plan is None
+            and "pose certificate" in attempt.reason
+            and planned is not None
+            and float(np.max(np.linalg.norm((measured.feet - planned)[:, :2], axis=1)))
+            <= _NEAR_PLAN_M
+        ):
+            # Feet settled just off their planned footholds (a rock's edge) where
+            # no certificate exists: plan from the footholds the plan had,
+            # which did; the integrators absorb the difference.
+            start = PlanStart(feet=planned.copy(), next_leg=start.next_leg)
+            plan, attempt, wall2 = self._make_plan(start, goal, budget)
+            wall += wall2
         first = None
         if plan is not None:
             first, wall2 = self._next_step(plan)

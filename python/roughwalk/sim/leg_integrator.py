@@ -59,11 +59,21 @@ class LegIntegrator:
         """Zero every Δ."""
         self.delta[:] = 0.0
 
-    def update(self, desired: DesiredState, measured: MeasuredState) -> NDArray[np.float64]:
-        """Update Δ from the trunk error and return the commanded joint angles q (12,) [rad]."""
+    def update(
+        self,
+        desired: DesiredState,
+        measured: MeasuredState,
+        offset: NDArray[np.float64] | None = None,
+    ) -> NDArray[np.float64]:
+        """Update Δ from the trunk error and return the commanded joint angles q (12,) [rad].
+
+        ``offset`` (4, 3) [m, base frame] moves every foot target on top of Δ
+        (the CoP stabiliser's trunk shift).
+        """
         cfg = self.config
+        moved = offset is not None and bool(np.any(offset))
         if not cfg.enabled:
-            return desired.q
+            return self._solve(desired, offset if moved else None)
         rot = quat_to_matrix(desired.base_quat)
         rot_bar = measured.rotation
         f_w = desired.feet
@@ -74,10 +84,17 @@ class LegIntegrator:
         self.delta[~down] *= self._decay
         norm = np.linalg.norm(self.delta, axis=1, keepdims=True)
         self.delta *= np.minimum(1.0, cfg.max_offset_m / np.maximum(norm, 1e-12))
-        active = np.any(np.abs(self.delta) > 1e-7, axis=1)
+        return self._solve(desired, offset if moved else None)
+
+    def _solve(
+        self, desired: DesiredState, offset: NDArray[np.float64] | None
+    ) -> NDArray[np.float64]:
+        """Joint angles IK_B(f_B + Δ + offset); legs without a correction keep the plan's."""
+        change = self.delta if offset is None else self.delta + offset
+        active = np.any(np.abs(change) > 1e-7, axis=1)
         if not np.any(active):
             return desired.q
-        feet_b = self.robot.foot_positions(desired.q) + self.delta
+        feet_b = self.robot.foot_positions(desired.q) + change
         q, _ = self.robot.inverse_kinematics(feet_b)
         # Legs without a correction keep their planned angles exactly.
         keep = self._leg_joints[~active].ravel()
