@@ -94,6 +94,9 @@ pub struct LegChain {
     arcs: Vec<closest::PlanarArc>,
     /// The HAA scan of the closest-point search.
     scan: closest::HaaScan,
+    /// The HAA body's placement on the trunk (see `placement`): the same
+    /// for every q, so link frames start from it.
+    haa_placement: (Mat3, Vec3, Vec3),
 }
 
 fn check_finite(name: &str, what: &str, values: &[f64]) -> CoreResult<()> {
@@ -176,6 +179,13 @@ impl LegChain {
         let ik_geometry = ik::IkGeometry::new(name, &params, &body_rot)?;
         let arcs = closest::planar_arcs(&ik_geometry, params.lower, params.upper);
         let scan = closest::haa_scan(&ik_geometry, params.lower, params.upper);
+        let haa_placement = Self::placement(
+            &params,
+            &body_rot,
+            0,
+            [0.0; 3],
+            &crate::kinematics::math::IDENTITY,
+        );
         Ok(Self {
             name: name.to_owned(),
             params,
@@ -184,6 +194,7 @@ impl LegChain {
             ik_geometry,
             arcs,
             scan,
+            haa_placement,
         })
     }
 
@@ -222,19 +233,38 @@ impl LegChain {
         };
         for (k, &angle) in q.iter().enumerate() {
             // MuJoCo's mj_kinematics for a hinge: place the body, then rotate it about the anchor.
-            let pos0 = add(parent_pos, mat_vec(&parent_rot, p.body_pos[k]));
-            let rot0 = mat_mul(&parent_rot, &self.body_rot[k]);
-            let anchor = add(pos0, mat_vec(&rot0, p.anchor[k]));
+            let (rot0, anchor, axis) = if k == 0 {
+                self.haa_placement
+            } else {
+                Self::placement(p, &self.body_rot, k, parent_pos, &parent_rot)
+            };
             let rot = mat_mul(&rot0, &axis_angle(p.axis[k], angle));
             let pos = sub(anchor, mat_vec(&rot, p.anchor[k]));
             out.pos[k] = pos;
             out.rot[k] = rot;
             out.anchor[k] = anchor;
-            out.axis[k] = mat_vec(&rot0, p.axis[k]);
+            out.axis[k] = axis;
             parent_pos = pos;
             parent_rot = rot;
         }
         out
+    }
+
+    /// Body `k` placed on its parent (at `parent_pos`, `parent_rot`) before
+    /// its joint turns: its rotation, and its joint's anchor and axis in the
+    /// base frame.
+    #[inline]
+    fn placement(
+        p: &LegParams,
+        body_rot: &[Mat3; 3],
+        k: usize,
+        parent_pos: Vec3,
+        parent_rot: &Mat3,
+    ) -> (Mat3, Vec3, Vec3) {
+        let pos0 = add(parent_pos, mat_vec(parent_rot, p.body_pos[k]));
+        let rot0 = mat_mul(parent_rot, &body_rot[k]);
+        let anchor = add(pos0, mat_vec(&rot0, p.anchor[k]));
+        (rot0, anchor, mat_vec(&rot0, p.axis[k]))
     }
 
     /// Foot centre in the base frame, FK_B(q) [m].

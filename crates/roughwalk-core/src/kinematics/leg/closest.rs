@@ -37,6 +37,9 @@ pub(super) struct PlanarArc {
     q2_start: f64,
     phi_start: f64,
     along_q2: bool,
+    /// radius·(cos, sin) of the start and end angles: the ends relative to
+    /// the centre, fixed, so not recomputed per query.
+    ends: [[f64; 2]; 2],
 }
 
 /// A joint range as (start, length), a full turn for unlimited or wider ranges.
@@ -70,31 +73,29 @@ pub(super) fn planar_arcs(g: &IkGeometry, lower: Vec3, upper: Vec3) -> Vec<Plana
     for phi in edges.chain(folds) {
         let m = g.planar_foot(phi);
         let beta = m[1].atan2(m[0]);
-        arcs.push(PlanarArc {
-            centre: [0.0, 0.0],
-            radius: m[0].hypot(m[1]),
-            start: q2_start + beta,
-            span: q2_span,
-            q2_start,
-            phi_start: phi,
-            along_q2: true,
-        });
+        arcs.push(PlanarArc::new(
+            [0.0, 0.0],
+            m[0].hypot(m[1]),
+            q2_start + beta,
+            q2_span,
+            (q2_start, phi),
+            true,
+        ));
     }
     // q_HFE fixed at a limit: the shank circles the knee as φ runs through its range.
     for q2 in [lower[1], upper[1]].into_iter().filter(|v| v.is_finite()) {
         let (s, c) = q2.sin_cos();
-        arcs.push(PlanarArc {
-            centre: [
+        arcs.push(PlanarArc::new(
+            [
                 c * g.thigh[0] - s * g.thigh[1],
                 s * g.thigh[0] + c * g.thigh[1],
             ],
-            radius: g.l2,
-            start: q2 + g.alpha2 + phi_start,
-            span: phi_span,
-            q2_start: q2,
-            phi_start,
-            along_q2: false,
-        });
+            g.l2,
+            q2 + g.alpha2 + phi_start,
+            phi_span,
+            (q2, phi_start),
+            false,
+        ));
     }
     arcs
 }
@@ -124,19 +125,39 @@ pub(super) fn haa_scan(g: &IkGeometry, lower: Vec3, upper: Vec3) -> HaaScan {
 }
 
 impl PlanarArc {
-    /// Distance [m] from `d` to the arc and the arc offset [rad] where it is attained.
-    fn closest(&self, d: [f64; 2]) -> (f64, f64) {
-        let v = [d[0] - self.centre[0], d[1] - self.centre[1]];
-        let r = v[0].hypot(v[1]);
+    fn new(
+        centre: [f64; 2],
+        radius: f64,
+        start: f64,
+        span: f64,
+        (q2_start, phi_start): (f64, f64),
+        along_q2: bool,
+    ) -> Self {
+        let end = |o: f64| {
+            let (s, c) = (start + o).sin_cos();
+            [radius * c, radius * s]
+        };
+        Self {
+            centre,
+            radius,
+            start,
+            span,
+            q2_start,
+            phi_start,
+            along_q2,
+            ends: [end(0.0), end(span)],
+        }
+    }
+
+    /// Distance [m] to the arc and the arc offset [rad] where it is attained,
+    /// from `v`, the point relative to the arc's centre, and `r` = |v|.
+    fn closest(&self, v: [f64; 2], r: f64) -> (f64, f64) {
         let offset = (v[1].atan2(v[0]) - self.start).rem_euclid(TAU);
         if self.span >= TAU || offset <= self.span {
             return ((r - self.radius).abs(), offset);
         }
-        let end_distance = |o: f64| {
-            let (s, c) = (self.start + o).sin_cos();
-            (d[0] - self.centre[0] - self.radius * c).hypot(d[1] - self.centre[1] - self.radius * s)
-        };
-        let (d0, d1) = (end_distance(0.0), end_distance(self.span));
+        let end_distance = |e: [f64; 2]| (v[0] - e[0]).hypot(v[1] - e[1]);
+        let (d0, d1) = (end_distance(self.ends[0]), end_distance(self.ends[1]));
         if d0 <= d1 {
             (d0, 0.0)
         } else {
@@ -184,11 +205,12 @@ impl LegChain {
         for arc in &self.arcs {
             // The distance to an arc is at least that to its circle: skip
             // arcs that cannot beat the best (it must be strictly less).
-            let (x, y) = (d[0] - arc.centre[0], d[1] - arc.centre[1]);
-            if (x.hypot(y) - arc.radius).abs() >= best.0 {
+            let v = [d[0] - arc.centre[0], d[1] - arc.centre[1]];
+            let r = v[0].hypot(v[1]);
+            if (r - arc.radius).abs() >= best.0 {
                 continue;
             }
-            let (dist, offset) = arc.closest(d);
+            let (dist, offset) = arc.closest(v, r);
             if dist < best.0 {
                 let (q2, phi) = arc.joints(offset);
                 best = (dist, q2, phi);
