@@ -67,7 +67,7 @@ def register(sub: Any) -> None:
     t.add_argument("--layers", default="64,64", help="hidden layer sizes (default 64,64)")
     t.add_argument("--g-max", type=float, help="cost threshold (default: start of the tail)")
     t.add_argument("--seed", type=int, default=0, help="training seed")
-    t.add_argument("--max-epochs", type=int, default=500, help="L-BFGS iterations")
+    t.add_argument("--max-epochs", type=int, default=300, help="L-BFGS iterations")
     t.add_argument("--note", default="", help="text stored in the model header")
     t.set_defaults(func=cmd_train)
 

@@ -76,17 +76,16 @@ def learned_init_rounds(
 
     Each round's model goes to ``out/learned_init_K.npz`` and its re-solves
     to ``out/round_K/`` (resumable like any run). ``n_tasks`` limits the
-    re-solved tasks to the first N of the run; the last round's model is
-    re-solved only with ``resolve_last``.
+    re-solved tasks to the first N of the run (every round trains on the
+    latest solution of every task then, re-solved or not); the last round's
+    model is re-solved only with ``resolve_last``.
     """
     folder = Path(out)
     data = read_run(run)
-    if n_tasks is not None:
-        data = data.select(np.asarray(data["index"]) < n_tasks)
     threshold = filter_good(data, g_max).g_max
     spec = ProblemSpec.from_dict(data.meta["problem"])
     space = TaskSpace.from_dict(data.meta["task_space"])
-    indices = [int(i) for i in data["index"]]
+    indices = [int(i) for i in data["index"] if n_tasks is None or i < n_tasks]
     reports: list[RoundReport] = []
     for k in range(1, rounds + 1):
         model, report = train_model(
@@ -116,5 +115,14 @@ def learned_init_rounds(
             indices=indices,
         )
         reports[-1].resolved = resolved
-        data = resolved
+        data = _latest(data, resolved)
     return reports
+
+
+def _latest(data: Dataset, resolved: Dataset) -> Dataset:
+    """``data`` with the rows of the re-solved tasks replaced by their re-solves."""
+    kept = data.select(~np.isin(data["index"], resolved["index"]))
+    if not len(kept):
+        return resolved
+    merged = Dataset(kept.columns, resolved.meta)
+    return merged.append(resolved)
