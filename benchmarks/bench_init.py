@@ -1,0 +1,292 @@
+"""Learned initial guesses against the heuristic: Melon et al.'s Figure 6 and Table I.
+
+Figure 6 (held-out tasks of one environment, the "test" split that training
+never sees): for the Heuristic and LearnedInit-1..3, the fraction of tasks
+converged against the iteration count, the distribution of final costs and
+of the maximum contact force. Every initialiser solves the same tasks with
+the same iteration limit (``--max-iter``, default 100); the solves are kept
+in resumable run folders under ``--experience`` so an interrupted benchmark
+continues.
+
+Table I: first-iteration and mean per-iteration time with all variables
+optimised (phase durations too), with fixed phase durations (the default),
+and with fixed durations and footholds (footholds held at the guess's).
+
+The issue's targets, for the 16-step single-pallet walk: LearnedInit's
+median solve ≤ 0.25 s on one core, ≥ 4× fewer iterations than the
+Heuristic (medians), ≤ 1 % of held-out tasks beyond g_max (the threshold
+training used, set from the Heuristic's costs) or infeasible.
+
+Run: ``roughwalk bench init [--env single_pallet] [--models DIR] [--tasks N]``.
+Writes ``benchmarks/results/init_ENV.json`` and ``init_ENV.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import time
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from roughwalk.cli.common import machine_description, result_envelope, write_json
+from roughwalk.learning import (
+    Dataset,
+    LearnedModel,
+    ProblemSpec,
+    build_problem,
+    generate,
+    shipped_models,
+    task_space,
+)
+from roughwalk.learning.filtering import feasible_mask
+from roughwalk.trajopt import HeuristicInitializer, TrajoptProblem
+
+RESULTS = Path(__file__).resolve().parent / "results"
+TARGETS = {"median_solve_s": 0.25, "iteration_ratio": 4.0, "beyond_g_max": 0.01}
+
+
+def _models(folder: Path | None, env: str) -> list[tuple[str, LearnedModel]]:
+    """LearnedInit-k models: ``learned_init_K.npz`` in ``folder``, else the shipped one."""
+    if folder is not None:
+        paths = sorted(folder.glob("learned_init_*.npz"))
+        return [(f"LearnedInit-{p.stem.rsplit('_', 1)[1]}", LearnedModel.load(p)) for p in paths]
+    out = []
+    for path in shipped_models():
+        model = LearnedModel.load(path)
+        if model.header["problem"]["terrain"] == env:
+            k = model.header["training"]["learned_init_round"]
+            out.append((f"LearnedInit-{k} (shipped)", model))
+    return out
+
+
+def _summary(data: Dataset, g_max: float, limit: int) -> dict[str, Any]:
+    solved = np.isin(data["status"], ("exact", "approximate"))
+    feasible = feasible_mask(data)
+    beyond = ~feasible | (data["cost"] > g_max)
+    its = data["iterations"]
+    curve = [float(np.mean(solved & (its <= k))) for k in range(limit + 1)]
+    times = data["solve_time_s"][solved]
+    return {
+        "tasks": len(data),
+        "converged": float(solved.mean()),
+        "median_iterations": float(np.median(its[solved])) if solved.any() else float("nan"),
+        "median_solve_s": float(np.median(times)) if times.size else float("nan"),
+        "beyond_g_max": float(beyond.mean()),
+        "median_cost": float(np.median(data["cost"][feasible])) if feasible.any() else None,
+        "converged_by_iteration": curve,
+        "costs": [float(c) for c in data["cost"]],
+        "max_forces_n": [float(f) for f in data["max_force_n"]],
+        "iterations": [int(i) for i in its],
+    }
+
+
+def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:
+    """Held-out solves from every initialiser, summarised."""
+    space = task_space(args.env)
+    base = args.experience / f"{space.name}_{spec.gait}{spec.steps}_test"
+    runs: dict[str, Dataset] = {}
+    runs["Heuristic"] = generate(
+        spec, space, args.tasks, base, split="test", max_iter=args.max_iter, progress=None
+    )
+    models = _models(args.models, args.env)
+    g_max = None
+    for name, model in models:
+        model.check_signature(spec.to_dict())
+        g_max = float(model.header["training"]["g_max"])
+        runs[name] = generate(
+            spec,
+            space,
+            args.tasks,
+            Path(f"{base}_{model.name}"),
+            split="test",
+            max_iter=args.max_iter,
+            model=model,
+            init=f"learned:{model.name}",
+            progress=None,
+        )
+    if g_max is None:
+        from roughwalk.learning import cost_threshold
+
+        g_max = cost_threshold(runs["Heuristic"]["cost"][feasible_mask(runs["Heuristic"])])
+    return {
+        "g_max": g_max,
+        "initializers": {k: _summary(v, g_max, args.max_iter) for k, v in runs.items()},
+    }
+
+
+def _fix_footholds(problem: TrajoptProblem, x0: np.ndarray) -> None:
+    """Hold every foothold variable (a stance's position) at its value in ``x0``."""
+    nlp = problem.formulation
+    start = 0
+    lbx, ubx = nlp.lbx.copy(), nlp.ubx.copy()
+    for v in nlp.variable_sets:
+        if v.name.startswith("foot_motion"):
+            for i, places in enumerate(v.index):  # type: ignore[attr-defined]
+                if places[0].kind == "pos" and len(places) > 1:
+                    lbx[start + i] = ubx[start + i] = x0[start + i]
+        start += v.size
+    nlp.lbx, nlp.ubx = lbx, ubx
+
+
+def table_1(args: argparse.Namespace, spec: ProblemSpec) -> list[dict[str, Any]]:
+    """First-iteration and mean per-iteration time [ms] for three variable sets."""
+    from roughwalk.trajopt.task import resolve
+
+    space = task_space(args.env)
+    tasks = space.sample(args.table_tasks, split="test")
+    rows = []
+    for label, optimise_durations, fix_feet in (
+        ("all variables optimised", True, False),
+        ("fixed phase durations", False, False),
+        ("fixed durations and footholds", False, True),
+    ):
+        variant = replace(spec, optimize_durations=optimise_durations)
+        # A private problem: fixing footholds changes its bounds.
+        problem = build_problem(variant) if not fix_feet else _fresh(variant)
+        first, per_iteration = [], []
+        for task in tasks:
+            x0 = HeuristicInitializer().guess(
+                problem.formulation, resolve(task, problem.body, problem.terrain)
+            )
+            if fix_feet:
+                _fix_footholds(problem, x0)
+            result = problem.solve(task, HeuristicInitializer(), max_iter=args.table_iterations)
+            history = result.history or []
+            if len(history) > 2:
+                first.append(history[1]["elapsed_s"])
+                later = (history[-1]["elapsed_s"] - history[1]["elapsed_s"]) / (len(history) - 2)
+                per_iteration.append(later)
+        rows.append(
+            {
+                "variables": label,
+                "n_variables": problem.n_variables,
+                "first_iteration_ms": 1000 * statistics.median(first) if first else None,
+                "mean_iteration_ms": 1000 * statistics.mean(per_iteration)
+                if per_iteration
+                else None,
+            }
+        )
+    return rows
+
+
+def _fresh(spec: ProblemSpec) -> TrajoptProblem:
+    shared = build_problem(spec)
+    return TrajoptProblem(shared.body, shared.terrain, shared.schedule, shared.config)
+
+
+def _plot(fig6: dict[str, Any], path: Path, env: str) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4))
+    for name, s in fig6["initializers"].items():
+        curve = s["converged_by_iteration"]
+        axes[0].plot(range(len(curve)), curve, label=name)
+        costs = np.array(s["costs"])
+        costs = costs[np.isfinite(costs) & (costs > 0)]
+        if costs.size:
+            axes[1].hist(
+                costs,
+                bins=np.geomspace(costs.min(), costs.max() * 1.01, 30),
+                histtype="step",
+                label=name,
+            )
+        axes[2].hist(s["max_forces_n"], bins=30, histtype="step", label=name)
+    axes[0].set(xlabel="iterations", ylabel="fraction converged", title=f"{env}: held-out tasks")
+    axes[1].axvline(fig6["g_max"], color="k", ls="--", lw=0.8, label="g_max")
+    axes[1].set(xscale="log", xlabel="final cost g(y)", ylabel="tasks", title="final cost")
+    axes[2].set(xlabel="maximum contact force [N]", ylabel="tasks", title="maximum force")
+    for ax in axes:
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main() -> None:
+    """Run the benchmark, print the table, write JSON and the plot."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--env", default="single_pallet", help="flat, single_pallet, double_pallet")
+    parser.add_argument(
+        "--models", type=Path, help="folder of learned_init_K.npz (default shipped)"
+    )
+    parser.add_argument("--tasks", type=int, default=50, help="held-out tasks (default 50)")
+    parser.add_argument("--max-iter", type=int, default=100, help="iteration limit (default 100)")
+    parser.add_argument("--experience", type=Path, default=Path(".experience"), help="run folders")
+    parser.add_argument("--table-tasks", type=int, default=3, help="tasks per Table I row")
+    parser.add_argument(
+        "--table-iterations", type=int, default=30, help="iterations per Table I solve"
+    )
+    parser.add_argument("--skip-table", action="store_true", help="Figure 6 only")
+    parser.add_argument("--json", type=Path, help="output JSON (default results/init_ENV.json)")
+    args = parser.parse_args()
+    spec = ProblemSpec("anymal_c", args.env, "walk", 16, 5.5)
+    started = time.perf_counter()
+    fig6 = figure_6(args, spec)
+    table = [] if args.skip_table else table_1(args, spec)
+    inits = fig6["initializers"]
+    heuristic = inits["Heuristic"]
+    learned = [k for k in inits if k != "Heuristic"]
+    best = learned[-1] if learned else None
+    print(f"Figure 6, {args.env}: {args.tasks} held-out tasks, g_max {fig6['g_max']:.4g}")
+    print(f"{'initialiser':28s} {'conv.':>6s} {'med. it':>8s} {'med. s':>8s} {'>g_max':>7s}")
+    for name, s in inits.items():
+        print(
+            f"{name:28s} {s['converged']:6.0%} {s['median_iterations']:8.1f} "
+            f"{s['median_solve_s']:8.3f} {s['beyond_g_max']:7.1%}"
+        )
+    targets: dict[str, Any] = {}
+    if best is not None:
+        b = inits[best]
+        ratio = heuristic["median_iterations"] / max(b["median_iterations"], 1.0)
+        targets = {
+            "initializer": best,
+            "median_solve_s": {
+                "measured": b["median_solve_s"],
+                "target": TARGETS["median_solve_s"],
+            },
+            "iteration_ratio": {"measured": ratio, "target": TARGETS["iteration_ratio"]},
+            "beyond_g_max": {"measured": b["beyond_g_max"], "target": TARGETS["beyond_g_max"]},
+        }
+        print(
+            f"targets ({best}): median solve {b['median_solve_s']:.3f} s (≤ 0.25), "
+            f"iterations {ratio:.1f}× fewer (≥ 4), beyond g_max {b['beyond_g_max']:.1%} (≤ 1 %)"
+        )
+    if table:
+        print("Table I (heuristic guess, medians over tasks):")
+        for row in table:
+            print(
+                f"  {row['variables']:32s} {row['n_variables']:5d} variables: "
+                f"first iteration {row['first_iteration_ms']:.0f} ms, "
+                f"then {row['mean_iteration_ms']:.1f} ms/iteration"
+            )
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    out = args.json or RESULTS / f"init_{args.env}.json"
+    write_json(
+        out,
+        result_envelope(
+            "bench_init",
+            machine=machine_description(),
+            load_average=list(os.getloadavg()),
+            env=args.env,
+            problem=spec.to_dict(),
+            figure_6=fig6,
+            table_1=table,
+            targets=targets,
+            wall_s=time.perf_counter() - started,
+        ),
+    )
+    picture = out.with_suffix(".png")
+    _plot(fig6, picture, args.env)
+    print(f"wrote {out} and {picture}")
+
+
+if __name__ == "__main__":
+    main()
