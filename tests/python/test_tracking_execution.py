@@ -28,11 +28,11 @@ def robot():
 
 @pytest.fixture(scope="module")
 def trot(robot) -> TrajoptResult:
-    """A short optimised flat-ground trot: 6 steps, 0.5 m in 2 s."""
+    """A short optimised flat-ground trot: 6 steps, 0.3 m in 2 s."""
     result = optimize_motion(
         robot,
         load_terrain("flat"),
-        Task((0.0, 0.0, 0.0), (0.5, 0.0, 0.0)),
+        Task((0.0, 0.0, 0.0), (0.3, 0.0, 0.0)),
         gait="trot",
         steps=6,
         duration=2.0,
@@ -64,7 +64,7 @@ def test_tracks_an_optimised_flat_ground_trot_to_the_goal_within_5_cm(trot):
     assert outcome.success, outcome.reason
     assert outcome.final_position_error_m < 0.05
     final = trot.sample(times=[trot.duration])["base_position"][0]
-    np.testing.assert_allclose(final[:2], [0.5, 0.0], atol=0.02)  # the planned goal, (x, y)
+    np.testing.assert_allclose(final[:2], [0.3, 0.0], atol=0.02)  # the planned goal, (x, y)
     log = outcome.log
     assert log is not None and log.t[-1] >= trot.duration + 1.0 - 1e-9
     # Feet touched down as planned: measured normal forces where stance was planned.

@@ -106,6 +106,17 @@ def test_qp_torques_and_forces_produce_its_accelerations_in_mujoco(world):
         m.opt.disableflags = saved
 
 
+def test_qp_hard_contacts_keep_stance_feet_still(world):
+    rng = np.random.default_rng(11)
+    _, mass, h, jc, qp, tasks = _problem(world, rng, np.array([3.0, -2.0, 4.0, 5.0, -5.0, 2.0]))
+    bias = rng.normal(0.0, 0.5, jc.shape[0])
+    sol = qp.solve(mass, h, jc, tasks, contact_bias=bias)
+    assert sol.success
+    np.testing.assert_allclose(jc @ sol.qacc + bias, 0.0, atol=1e-6)
+    soft = qp.solve(mass, h, jc, tasks)
+    assert np.abs(jc @ soft.qacc + bias).max() > 1e-3  # the hard rows did something
+
+
 def test_friction_pyramid_contains_the_cone_inside_and_excludes_outside():
     rng = np.random.default_rng(3)
     normal = rng.normal(size=3)

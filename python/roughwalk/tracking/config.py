@@ -48,6 +48,9 @@ class TrackingGains:
         Fraction of the base position error added to the footholds.
     max_foothold_shift_m:
         Largest foothold correction [m].
+    max_swing_feedback:
+        Largest swing-foot feedback acceleration [m/s²]: a far-off foot must
+        not whip its leg, whose reaction spins a trunk in flight.
     """
 
     base_kp: float = 100.0
@@ -60,9 +63,14 @@ class TrackingGains:
     foothold_velocity_gain: float = 0.22
     foothold_position_gain: float = 0.5
     max_foothold_shift_m: float = 0.12
+    max_swing_feedback: float = 25.0
 
     def __post_init__(self) -> None:
-        _positive(self, tuple(self.__dataclass_fields__)[:7] + ("max_foothold_shift_m",), "gains")
+        _positive(
+            self,
+            tuple(self.__dataclass_fields__)[:7] + ("max_foothold_shift_m", "max_swing_feedback"),
+            "gains",
+        )
         if not (self.foothold_velocity_gain >= 0 and self.foothold_position_gain >= 0):
             raise ConfigError(
                 "gains.foothold_velocity_gain and gains.foothold_position_gain must be ≥ 0, got "
@@ -82,6 +90,9 @@ class TaskWeights:
         Swing-foot acceleration task.
     stance_foot:
         Stance feet do not accelerate (J q̈ + J̇ q̇ = 0); heavy, a soft contact constraint.
+    flight_base_angular:
+        Base angular task weight while no foot bears load: the trunk can only
+        be turned by swinging the legs then, so keep it small (0: let it spin).
     force:
         Contact force tracking [1/N²]: the planned forces are a preference, the
         base tasks decide.
@@ -93,12 +104,18 @@ class TaskWeights:
     base_angular: float = 1.0
     swing_foot: float = 1.0
     stance_foot: float = 100.0
+    flight_base_angular: float = 0.0
     force: float = 1e-4
     joint_acceleration: float = 1e-4
     torque: float = 1e-6
 
     def __post_init__(self) -> None:
-        _positive(self, tuple(self.__dataclass_fields__), "weights")
+        names = tuple(n for n in self.__dataclass_fields__ if n != "flight_base_angular")
+        _positive(self, names, "weights")
+        if not self.flight_base_angular >= 0:
+            raise ConfigError(
+                f"weights.flight_base_angular must be ≥ 0, got {self.flight_base_angular}"
+            )
 
 
 @dataclass(frozen=True)
@@ -157,6 +174,13 @@ class TrackingConfig:
         Bounds [N] on a stance foot's normal force.
     qp_solver:
         qpsolvers' name of the QP solver ("proxqp", "osqp", ...).
+    hard_contacts:
+        Stance feet do not accelerate as a hard constraint of the QP
+        (Bellicoso et al.'s highest priority) instead of a heavy task.
+    track_com:
+        Track the planned centre of mass with the whole robot's (the single
+        rigid body's linear dynamics hold for it exactly) instead of the
+        trunk's position.
     """
 
     control_hz: float = 400.0
@@ -168,6 +192,8 @@ class TrackingConfig:
     min_normal_force_n: float = 2.0
     max_normal_force_n: float = 1500.0
     qp_solver: str = "proxqp"
+    track_com: bool = False
+    hard_contacts: bool = True
     gains: TrackingGains = field(default_factory=TrackingGains)
     weights: TaskWeights = field(default_factory=TaskWeights)
     contact: ContactStateConfig = field(default_factory=ContactStateConfig)

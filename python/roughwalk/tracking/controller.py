@@ -154,6 +154,7 @@ class WholeBodyController:
         self._mass = np.zeros((self.nv, self.nv))
         self._jacp = np.zeros((3, self.nv))
         self._jacdot = np.zeros((3, self.nv))
+        self._scratch = mujoco.MjData(m)
 
     # ---- one tick -------------------------------------------------------------------
 
@@ -162,6 +163,9 @@ class WholeBodyController:
         started = time.perf_counter()
         world = self.world
         m, d = world.model, world.data
+        # mj_step leaves positions one physics step ahead of the kinematics it
+        # computed; bring everything to the current state before reading it.
+        mujoco.mj_forward(m, d)
         state = measure(world)
         # measure() gives the trunk's centre-of-mass velocity; the tasks need
         # the base frame origin's, which is the free joint's q̇[0:3].
@@ -183,7 +187,8 @@ class WholeBodyController:
         layout = self.qp.layout(self.nv, len(stance))
         tasks = self._tasks(layout, state, ref, estimate, stance, points, foot_vel, jac, bias)
         jc = jac[stance].reshape(-1, self.nv)
-        solution = self.qp.solve(self._mass, h, jc, tasks)
+        hard = bias[stance].ravel() if self.config.hard_contacts else None
+        solution = self.qp.solve(self._mass, h, jc, tasks, contact_bias=hard)
         qp_forces = np.zeros((4, 3))
         if solution.success:
             self.torques = solution.tau
@@ -200,6 +205,25 @@ class WholeBodyController:
             qp_forces,
             time.perf_counter() - started,
         )
+
+    def _com_jacobian(
+        self,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """Whole-body CoM Jacobian (3, nv), J̇q̇ [m/s²] (by a 1 µs step), CoM [m] and its velocity."""
+        m, d = self.world.model, self.world.data
+        jac = np.zeros((3, self.nv))
+        mujoco.mj_jacSubtreeCom(m, d, jac, self.world.base_body)
+        s = self._scratch
+        s.qpos[:] = d.qpos
+        eps = 1e-6
+        mujoco.mj_integratePos(m, s.qpos, d.qvel, eps)
+        mujoco.mj_kinematics(m, s)
+        mujoco.mj_comPos(m, s)
+        ahead = np.zeros((3, self.nv))
+        mujoco.mj_jacSubtreeCom(m, s, ahead, self.world.base_body)
+        bias = (ahead - jac) @ d.qvel / eps
+        com = d.subtree_com[self.world.base_body].copy()
+        return jac, bias, com, jac @ d.qvel
 
     def _foot_jacobians(
         self, points: NDArray[np.float64]
@@ -252,6 +276,22 @@ class WholeBodyController:
         # q̈[3:6] the body-frame angular acceleration, so R q̈[3:6] = ω̇ (world).
         j_lin = np.zeros((3, self.nv))
         j_lin[:, 0:3] = np.eye(3)
+        bias_lin = np.zeros(3)
+        if (
+            cfg.track_com
+            and ref.com_pos is not None
+            and ref.com_vel is not None
+            and ref.com_acc is not None
+        ):
+            # The single-rigid-body plan's linear dynamics, m c̈ = Σf + m g, hold
+            # exactly for the whole robot's centre of mass (not for the trunk,
+            # which swinging legs push around): track the planned c itself.
+            j_lin, bias_lin, com, com_vel = self._com_jacobian()
+            a_lin = (
+                ref.com_acc
+                + scale * g.base_kp * (ref.com_pos - com)
+                + g.base_kd * (ref.com_vel - com_vel)
+            )
         trunk = quat_to_matrix(d.qpos[3:7])
         j_ang = np.zeros((3, self.nv))
         j_ang[:, 3:6] = trunk
@@ -260,9 +300,15 @@ class WholeBodyController:
             # In flight nothing but gravity moves the base: a base task would
             # only whirl the legs to turn the trunk by reaction.
             tasks += [
-                motion_task("base_linear", layout, j_lin, np.zeros(3), a_lin, w.base_linear),
+                motion_task("base_linear", layout, j_lin, bias_lin, a_lin, w.base_linear),
                 motion_task("base_angular", layout, j_ang, np.zeros(3), a_ang, w.base_angular),
             ]
+        elif w.flight_base_angular > 0:
+            tasks.append(
+                motion_task(
+                    "base_angular", layout, j_ang, np.zeros(3), a_ang, w.flight_base_angular
+                )
+            )
         c = cfg.contact
         # Raibert/capture-point foothold correction, blended in over the swing.
         shift = g.foothold_velocity_gain * (state.base_vel - ref.base_vel) + (
@@ -293,11 +339,13 @@ class WholeBodyController:
                 target = target - depth * _Z
                 target_vel = -c.search_speed_m_s * _Z if depth < c.search_depth_m else np.zeros(3)
                 target_acc = np.zeros(3)
-            a_foot = (
-                target_acc
-                + g.swing_kp * (target - points[leg])
-                + g.swing_kd * (target_vel - foot_vel[leg])
+            feedback = g.swing_kp * (target - points[leg]) + g.swing_kd * (
+                target_vel - foot_vel[leg]
             )
+            size = float(np.linalg.norm(feedback))
+            if size > g.max_swing_feedback:
+                feedback *= g.max_swing_feedback / size
+            a_foot = target_acc + feedback
             tasks.append(
                 motion_task(f"swing_foot {leg}", layout, jac[leg], bias[leg], a_foot, w.swing_foot)
             )

@@ -51,6 +51,9 @@ class ReferenceSample:
         (4, 3) planned contact forces on the feet [N].
     swing_progress:
         (4,) fraction of the current swing elapsed (0 in stance).
+    com_pos, com_vel, com_acc:
+        (3,) the planned whole-body centre of mass [m], [m/s], [m/s²] (the
+        single rigid body's; None when the reference plans the base only).
     """
 
     t: float
@@ -66,6 +69,9 @@ class ReferenceSample:
     contact: NDArray[np.bool_]
     forces: NDArray[np.float64]
     swing_progress: NDArray[np.float64]
+    com_pos: NDArray[np.float64] | None = None
+    com_vel: NDArray[np.float64] | None = None
+    com_acc: NDArray[np.float64] | None = None
 
     @property
     def base_quat(self) -> NDArray[np.float64]:
@@ -113,6 +119,9 @@ class Reference:
                 np.ones(4, dtype=bool) if end.contact.all() else end.contact,
                 end.forces,
                 np.zeros(4),
+                end.com_pos,
+                None if end.com_pos is None else zero3,
+                None if end.com_pos is None else zero3,
             )
         return replace(self._final, t=float(t))
 
@@ -160,6 +169,9 @@ class Reference:
                 contact=np.array([bool(schedule.in_contact(i, t)[0]) for i in range(4)]),
                 forces=np.array([f.evaluate(t)[0][0] for f in splines.forces]),
                 swing_progress=np.array([progress(i, t) for i in range(4)]),
+                com_pos=com,
+                com_vel=com_vel,
+                com_acc=com_acc,
             )
 
         return cls(result.duration, sample, name=f"{schedule.name or 'trajopt'} motion")

@@ -119,6 +119,7 @@ class WholeBodyQP:
         contact_jacobian: ArrayLike,
         tasks: Sequence[LeastSquaresTask],
         normals: ArrayLike | None = None,
+        contact_bias: ArrayLike | None = None,
     ) -> QPSolution:
         """Minimise Σ w‖A x − b‖² subject to dynamics, friction and torque limits.
 
@@ -134,6 +135,9 @@ class WholeBodyQP:
             The objective's tasks, all over this layout.
         normals:
             (nc, 3) terrain normals at the stance feet (default: z up).
+        contact_bias:
+            (3·nc,) J̇_c q̇ [m/s²]: when given, the stance feet do not accelerate,
+            J_c q̈ + J̇_c q̇ = 0, as a hard constraint (else it is up to the tasks).
         """
         m = np.asarray(mass_matrix, dtype=float)
         h = np.asarray(bias, dtype=float)
@@ -150,6 +154,11 @@ class WholeBodyQP:
         a_eq[self.actuated_dofs, lay.tau] = -np.eye(lay.nu)
         a_eq[:, nv + lay.nu :] = -jc.T
         b_eq = -h
+        if contact_bias is not None and nc:
+            rows = np.zeros((3 * nc, n))
+            rows[:, lay.qacc] = jc
+            a_eq = np.vstack([a_eq, rows])
+            b_eq = np.concatenate([b_eq, -np.asarray(contact_bias, dtype=float)])
 
         g_rows: list[NDArray[np.float64]] = []
         h_rows: list[NDArray[np.float64]] = []

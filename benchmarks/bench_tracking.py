@@ -1,0 +1,317 @@
+"""Execution success of optimised motions on ANYmal C in MuJoCo (Melon et al. 2020, Figs. 8, 4).
+
+Figure 8's protocol: for held-out tasks of each environment (the double
+pallet, the single pallet and flat ground; the task spaces of
+``roughwalk.learning``), for each initialiser and each IPOPT iteration limit
+(0, 1, 2, 5, 10, 20, 30), solve the NLP (Melon et al.'s costs, walk of 16
+steps in 5.5 s as their pallet tasks), execute the result with the
+whole-body controller (``roughwalk.track``) and record the success rate and
+the mean base tracking error; with fixed and with optimised phase durations.
+20 tasks per point by default, ``--full`` the paper's 100; ``--tasks`` and
+``--iters`` make a short run possible. Solves and executions spread over the
+learned-initialisation wing's executors (``--workers``, ``--executor ray``).
+
+Figure 4's comparison (``--figure4``): the single-pallet step solved with and
+without Melon et al.'s costs (``melon_config`` against TOWR's feasibility
+problem, ``towr_config``), both executed; pictures of each go beside the JSON.
+
+The ``learned`` initialiser comes from ``roughwalk.learning`` when it is
+installed; otherwise the benchmark says so and runs the heuristic only.
+
+Run: ``roughwalk bench tracking [--tasks N] [--iters 0,5] [--env single_pallet]``.
+Writes ``benchmarks/results/tracking.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from roughwalk.cli.common import machine_description, result_envelope, write_json
+
+RESULTS = Path(__file__).resolve().parent / "results" / "tracking.json"
+ITERATIONS = (0, 1, 2, 5, 10, 20, 30)
+ENVIRONMENTS = ("double_pallet", "single_pallet", "flat")
+# The pallet tasks of the paper walk 16 steps in 5.5 s; the learned models share it.
+GAIT, STEPS, DURATION = "walk", 16, 5.5
+
+
+@dataclass(frozen=True)
+class Job:
+    """One solve-and-execute."""
+
+    env: str
+    terrain: str
+    init: str
+    max_iter: int
+    optimize_durations: bool
+    index: int
+    start: tuple[float, float, float]
+    goal: tuple[float, float, float]
+
+
+def _task_space(env: str) -> tuple[str, list[Any] | None, str]:
+    """(terrain, sampler, note): the learning wing's held-out tasks, or a fallback box."""
+    try:
+        from roughwalk.learning import task_space
+    except ImportError as e:
+        return env, None, f"roughwalk.learning unavailable ({e}); fallback task box"
+    space = task_space(env)
+    return space.terrain, [space], ""
+
+
+def held_out_tasks(env: str, n: int, seed: int = 0) -> tuple[str, list[Any], str]:
+    """``n`` held-out tasks of ``env`` (the test split of its task space)."""
+    terrain, spaces, note = _task_space(env)
+    if spaces is not None:
+        return terrain, spaces[0].sample(n, seed=seed, split="test"), note
+    import numpy as np
+
+    from roughwalk.trajopt import Task
+
+    goals = {"flat": (1.5, 0.0, 0.0), "single_pallet": (1.6, 0.0, 0.0)}
+    goal = goals.get(env, (1.8, 0.0, 0.0))
+    rng = np.random.default_rng([seed, 1])
+    tasks = [
+        Task(
+            (float(rng.uniform(-0.5, 0.5)), float(rng.uniform(-0.75, 0.75)), 0.0),
+            goal,
+        )
+        for _ in range(n)
+    ]
+    return terrain, tasks, note
+
+
+def learned_available() -> str:
+    """Why the ``learned`` initialiser cannot be made (empty when it can)."""
+    try:
+        import roughwalk.learning  # noqa: F401  (registers the initialiser)
+        from roughwalk.trajopt import make_initializer
+
+        make_initializer("learned")
+    except Exception as e:  # noqa: BLE001  (any failure means: run without it, and say why)
+        return f"{type(e).__name__}: {e}"
+    return ""
+
+
+def run_job(job: Job) -> dict[str, Any]:
+    """Solve the job's task and execute the result; a plain dict (picklable)."""
+    from roughwalk.robots import load_robot
+    from roughwalk.terrain import load_terrain
+    from roughwalk.tracking import track
+    from roughwalk.trajopt import Task, melon_config, optimize_motion
+
+    if job.init == "learned":
+        import roughwalk.learning  # noqa: F401
+    robot = load_robot("anymal_c")
+    terrain = load_terrain(job.terrain)
+    config = melon_config(
+        gait=GAIT, steps=STEPS, duration=DURATION, optimize_durations=job.optimize_durations
+    )
+    row: dict[str, Any] = {
+        "env": job.env,
+        "init": job.init,
+        "max_iter": job.max_iter,
+        "optimize_durations": job.optimize_durations,
+        "index": job.index,
+        "start": list(job.start),
+    }
+    started = time.perf_counter()
+    try:
+        result = optimize_motion(
+            robot,
+            terrain,
+            Task(job.start, job.goal),
+            config=config,
+            init=job.init,
+            solver__max_iter=max(job.max_iter, 0),
+        )
+    except Exception as e:  # noqa: BLE001  (a failed solve is a data point, not a crash)
+        row.update(success=False, reason=f"solve raised {type(e).__name__}: {e}")
+        return row
+    row.update(
+        solve_status=result.status.value,
+        iterations=result.iterations,
+        solve_time_s=result.solve_time_s,
+        max_violation=result.max_violation if math.isfinite(result.max_violation) else None,
+    )
+    if result.splines is None:
+        row.update(success=False, reason="no trajectory")
+        return row
+    try:
+        outcome = track(result, robot, terrain)
+    except Exception as e:  # noqa: BLE001
+        row.update(success=False, reason=f"execution raised {type(e).__name__}: {e}")
+        return row
+    row.update(
+        success=outcome.success,
+        reason=outcome.reason,
+        mean_position_error_m=outcome.mean_position_error_m,
+        final_position_error_m=outcome.final_position_error_m,
+        max_orientation_error_rad=outcome.max_orientation_error_rad,
+        fell=outcome.fell,
+        time_s=time.perf_counter() - started,
+    )
+    return row
+
+
+def _executor(name: str, workers: int, address: str | None) -> Any:
+    try:
+        from roughwalk.learning import make_executor
+    except ImportError:
+        return None
+    return make_executor(name, workers=workers, address=address)
+
+
+def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Success rate and mean tracking error per (env, init, durations, max_iter)."""
+    groups: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
+    for r in rows:
+        key = (r["env"], r["init"], r["optimize_durations"], r["max_iter"])
+        groups.setdefault(key, []).append(r)
+    out = []
+    for (env, init, opt, it), rs in sorted(groups.items(), key=lambda kv: str(kv[0])):
+        errors = [r["mean_position_error_m"] for r in rs if "mean_position_error_m" in r]
+        out.append(
+            {
+                "env": env,
+                "init": init,
+                "optimize_durations": opt,
+                "max_iter": it,
+                "tasks": len(rs),
+                "success_rate": sum(bool(r.get("success")) for r in rs) / len(rs),
+                "mean_tracking_error_m": sum(errors) / len(errors) if errors else None,
+                "solved_rate": sum(r.get("solve_status") in ("exact", "acceptable") for r in rs)
+                / len(rs),
+            }
+        )
+    return out
+
+
+def print_table(summary: list[dict[str, Any]]) -> None:
+    """The Figure 8 table."""
+    print(
+        f"{'env':15s} {'init':10s} {'durations':9s} {'iters':>5s} {'tasks':>5s} "
+        f"{'success':>8s} {'tracking err':>12s}"
+    )
+    for s in summary:
+        err = s["mean_tracking_error_m"]
+        kind = "optimised" if s["optimize_durations"] else "fixed"
+        print(
+            f"{s['env']:15s} {s['init']:10s} {kind:9s}"
+            f" {s['max_iter']:5d} {s['tasks']:5d} {100 * s['success_rate']:7.0f}% "
+            f"{'—' if err is None else f'{100 * err:9.1f} cm':>12s}"
+        )
+
+
+def figure4(out_dir: Path) -> list[dict[str, Any]]:
+    """The single-pallet step with and without Melon et al.'s costs, executed."""
+    from roughwalk.robots import load_robot
+    from roughwalk.terrain import load_terrain
+    from roughwalk.tracking import track
+    from roughwalk.trajopt import Task, melon_config, optimize_motion, towr_config
+    from roughwalk.viz.tracking import save_tracking_picture
+
+    robot = load_robot("anymal_c")
+    terrain = load_terrain("single_pallet")
+    task = Task((-0.3, 0.2, 0.3), (1.6, 0.0, 0.0))
+    rows = []
+    for name, config in (("with Melon's costs", melon_config()), ("TOWR only", towr_config())):
+        result = optimize_motion(robot, terrain, task, config=config, body_model="robot")
+        row: dict[str, Any] = {"variant": name, "solve_status": result.status.value}
+        if result.splines is not None:
+            outcome = track(result, robot, terrain)
+            picture = out_dir / f"tracking_figure4_{'melon' if 'Melon' in name else 'towr'}.png"
+            save_tracking_picture(outcome, picture, title=f"single pallet, {name}")
+            log = outcome.log
+            assert log is not None
+            row.update(
+                success=outcome.success,
+                reason=outcome.reason,
+                mean_position_error_m=outcome.mean_position_error_m,
+                max_orientation_error_rad=outcome.max_orientation_error_rad,
+                peak_angular_velocity_rad_s=float(abs(log.base_angvel).max()),
+                picture=str(picture),
+            )
+        rows.append(row)
+        print(f"figure 4, {name}: {row}")
+    return rows
+
+
+def main() -> None:
+    """Run the benchmark and write its JSON."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--tasks", type=int, default=20, help="held-out tasks per point")
+    parser.add_argument("--full", action="store_true", help="the paper's 100 tasks per point")
+    parser.add_argument(
+        "--iters", default=",".join(map(str, ITERATIONS)), help="IPOPT iteration limits"
+    )
+    parser.add_argument("--env", default=",".join(ENVIRONMENTS), help="environments")
+    parser.add_argument("--init", default="heuristic,learned", help="initialisers")
+    parser.add_argument(
+        "--durations", default="fixed,optimised", help="phase durations: fixed, optimised"
+    )
+    parser.add_argument("--workers", type=int, default=1, help="local worker processes")
+    parser.add_argument("--executor", default="local", help="local or ray")
+    parser.add_argument("--address", help="Ray cluster address")
+    parser.add_argument("--figure4", action="store_true", help="also run Figure 4's comparison")
+    parser.add_argument("--seed", type=int, default=0, help="task sampling seed")
+    parser.add_argument("--json", type=Path, default=RESULTS, help="where to write the results")
+    args = parser.parse_args()
+
+    n = 100 if args.full else args.tasks
+    iters = [int(v) for v in args.iters.split(",") if v]
+    inits = [v for v in args.init.split(",") if v]
+    notes = []
+    if "learned" in inits:
+        why = learned_available()
+        if why:
+            notes.append(f"learned initialiser unavailable ({why}); heuristic only")
+            print(notes[-1])
+            inits = [i for i in inits if i != "learned"]
+    durations = [d == "optimised" for d in args.durations.split(",") if d]
+    jobs = []
+    for env in [e for e in args.env.split(",") if e]:
+        terrain, tasks, note = held_out_tasks(env, n, args.seed)
+        if note:
+            notes.append(f"{env}: {note}")
+            print(notes[-1])
+        for init in inits:
+            for opt in durations:
+                for it in iters:
+                    for i, t in enumerate(tasks):
+                        jobs.append(Job(env, terrain, init, it, opt, i, t.start, t.goal))
+    print(f"{len(jobs)} solve-and-execute jobs ...")
+    executor = _executor(args.executor, args.workers, args.address)
+    started = time.perf_counter()
+    rows = list(executor.run(run_job, jobs)) if executor else [run_job(j) for j in jobs]
+    elapsed = time.perf_counter() - started
+    summary = summarise(rows)
+    print_table(summary)
+    fig4 = figure4(args.json.parent) if args.figure4 else []
+    write_json(
+        args.json,
+        result_envelope(
+            "bench_tracking",
+            robot="anymal_c",
+            machine=machine_description(),
+            tasks_per_point=n,
+            gait=GAIT,
+            steps=STEPS,
+            duration=DURATION,
+            notes=notes,
+            wall_time_s=elapsed,
+            summary=summary,
+            runs=rows,
+            figure4=fig4,
+        ),
+    )
+    print(f"wrote {args.json} ({elapsed:.0f} s)")
+
+
+if __name__ == "__main__":
+    main()
