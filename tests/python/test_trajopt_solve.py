@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+import ctypes
 import json
+import os
 from pathlib import Path
 
+import casadi as ca
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from roughwalk.errors import InvalidArgumentError
+from roughwalk.errors import ConfigError, InvalidArgumentError
 from roughwalk.terrain import load_terrain
 from roughwalk.trajopt import (
     TrajoptResult,
@@ -17,6 +20,8 @@ from roughwalk.trajopt import (
     optimize_motion,
     towr_config,
 )
+from roughwalk.trajopt.parameters import SolverOptions
+from roughwalk.trajopt.solver import _single_threaded_blas
 from roughwalk.trajopt.terrain_model import TerrainModel
 from roughwalk.trajopt.variables import euler_to_rotation
 
@@ -325,3 +330,25 @@ def test_footsteps_guess_from_a_plan(tmp_path: Path) -> None:
             init=f"footsteps:{plan}",
             duration=2.4,
         )
+
+
+def test_mumps_runs_on_one_blas_thread_and_orderings_are_checked() -> None:
+    library = Path(ca.__file__).resolve().parent / "libcasadi-tp-openblas.so.0"
+    if not library.exists() or "OPENBLAS_NUM_THREADS" in os.environ:
+        pytest.skip("CasADi without its own OpenBLAS, or the user chose the thread count")
+    assert _single_threaded_blas()
+    assert ctypes.CDLL(str(library)).openblas_get_num_threads() == 1
+    with pytest.raises(ConfigError, match="mumps_pivot_order must be None, 0, 2, 4, 5, 6 or 7"):
+        SolverOptions(mumps_pivot_order=3)
+    # The ordering is IPOPT's: an explicit one solves the same problem.
+    result = optimize_motion(
+        None,
+        "flat",
+        ((0.0, 0.0, 0.0), (0.8, 0.0, 0.0)),
+        config=towr_config(optimize_durations=True),
+        gait="walk",
+        steps=8,
+        duration=3.0,
+        solver__mumps_pivot_order=0,
+    )
+    assert result.solved, result.message
