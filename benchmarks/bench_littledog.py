@@ -18,7 +18,10 @@ runs on generated large rocks under a lateral push, a friction drop and a
 ±1 cm error in the map the planner sees, and reports how many runs the
 reflexes and re-planning rescued (succeeded after at least one reflex).
 
-Run: ``roughwalk bench littledog [--seeds N] [--full] [--disturbances]``.
+Run: ``roughwalk bench littledog [--seeds N] [--full] [--disturbances] [--jobs N]``.
+With ``--jobs`` runs go to N processes at once; every run's on-line
+planning and optimisation is charged in wall time, so on a machine with
+fewer free cores than jobs the waits, and so the speeds, suffer.
 Writes ``benchmarks/results/littledog.json``.
 """
 
@@ -26,7 +29,9 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -94,6 +99,32 @@ def one_run(
     return out
 
 
+def seeded_run(
+    args: tuple[str, int, bool, float, str | None, float],
+) -> dict[str, Any]:
+    """One benchmark run from picklable arguments (for a process pool).
+
+    ``args``: terrain class, seed, full, plan time [s], disturbance name
+    (None, "push", "friction", "map") and push impulse [N·s].
+    """
+    kind, seed, full, plan_time, disturbance, push = args
+    spec, start, goal = course(kind, seed, full)
+    made: list[Any] = []
+    if disturbance is not None:
+        if spec.endswith(".mat"):
+            spec = f"large_rocks:seed={seed - 100}"
+            start, goal = (0.25, 0.0, 0.0), (1.05, 0.0)
+        if disturbance == "push":
+            made = [Push(push, at_s=2.0 + 0.7 * (seed - 100))]
+        elif disturbance == "friction":
+            made = [FrictionDrop(0.5)]
+        else:
+            made = [MapError(0.01, seed=seed - 100)]
+    r = one_run(spec, start, goal, plan_time, made)
+    r["seed"] = seed
+    return r
+
+
 def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
     """Success rate, speeds of the successful runs, counts."""
     ok = [r for r in runs if r["success"]]
@@ -143,6 +174,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     ap.add_argument("--push", type=float, default=0.6, help="lateral push impulse [N·s]")
     ap.add_argument("--json", default=str(RESULTS), help="where to write the results")
+    ap.add_argument("--jobs", type=int, default=1, help="runs at once (processes)")
     args = ap.parse_args(argv)
     seeds = args.seeds if args.seeds is not None else (10 if args.full else 2)
     classes = [c.strip() for c in args.classes.split(",") if c.strip()]
@@ -157,32 +189,30 @@ def main(argv: list[str] | None = None) -> int:
     print(header)
     print("-" * len(header))
     table: dict[str, Any] = {}
-    for kind in classes:
-        runs = []
-        for seed in range(seeds):
-            spec, start, goal = course(kind, seed, args.full)
-            r = one_run(spec, start, goal, args.plan_time, [])
-            r["seed"] = seed
-            runs.append(r)
-        table[kind] = {"summary": summarize(runs), "runs": runs}
-        print_row(kind, table[kind]["summary"])
+    load_before = os.getloadavg()
+    jobs: dict[str, list[tuple[str, int, bool, float, str | None, float]]] = {
+        kind: [(kind, seed, args.full, args.plan_time, None, args.push) for seed in range(seeds)]
+        for kind in classes
+    }
     if args.disturbances or args.full:
-        cases = {
-            f"push {args.push:g} N·s": lambda seed: [Push(args.push, at_s=2.0 + 0.7 * seed)],
-            "friction 0.5": lambda seed: [FrictionDrop(0.5)],
-            "map error ±1 cm": lambda seed: [MapError(0.01, seed=seed)],
+        for key, name in (
+            (f"large_rocks + push {args.push:g} N·s", "push"),
+            ("large_rocks + friction 0.5", "friction"),
+            ("large_rocks + map error ±1 cm", "map"),
+        ):
+            jobs[key] = [
+                ("large_rocks", seed + 100, args.full, args.plan_time, name, args.push)
+                for seed in range(seeds)
+            ]
+    with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+        pending = {
+            key: [pool.submit(seeded_run, job) for job in todo] for key, todo in jobs.items()
         }
-        for name, make in cases.items():
-            runs = []
-            for seed in range(seeds):
-                spec, start, goal = course("large_rocks", seed + 100, args.full)
-                if spec.endswith(".mat"):
-                    spec = f"large_rocks:seed={seed}"
-                    start, goal = (0.25, 0.0, 0.0), (1.05, 0.0)
-                r = one_run(spec, start, goal, args.plan_time, make(seed))
-                r["seed"] = seed
-                runs.append(r)
-            key = f"large_rocks + {name}"
+        for key, futures in pending.items():
+            runs = [f.result() for f in futures]
+            if key not in classes:
+                for r in runs:
+                    r["seed"] -= 100
             table[key] = {"summary": summarize(runs), "runs": runs}
             print_row(key, table[key]["summary"])
     write_json(
@@ -194,6 +224,9 @@ def main(argv: list[str] | None = None) -> int:
             seeds=seeds,
             full=args.full,
             plan_time_s=args.plan_time,
+            jobs=args.jobs,
+            load_average_before=list(load_before),
+            load_average_after=list(os.getloadavg()),
             target_cm_s=TARGET_CM_S,
             classes=table,
         ),
