@@ -453,5 +453,40 @@ mod tests {
             prop_assert!(r.reachable && r.within_limits, "{q:?} → {r:?}");
             prop_assert!(norm(sub(leg.fk(r.q), f)) <= 1e-9);
         }
+
+        #[test]
+        fn ik_frames_and_exact_ik_agree_with_ik(
+            u in prop::array::uniform3(0.0..=1.0f64),
+            which in 0usize..6,
+            push in 0.0..0.3f64,
+        ) {
+            // Reachable targets, and targets pushed out along their direction
+            // from the hip (often out of reach).
+            let leg = &test_legs()[which];
+            let f = leg.fk(sample_q(leg, u));
+            let out = sub(f, leg.haa_anchor_base);
+            let target = add(f, scale(out, push / norm(out).max(1e-9)));
+            let r = leg.ik(target, None);
+            let (with, frames) = leg.ik_with_frames(target, None);
+            prop_assert_eq!(with, r);
+            prop_assert_eq!(frames, leg.link_frames(r.q));
+            match leg.ik_exact(target, None) {
+                Some((exact, frames)) => {
+                    prop_assert_eq!(exact, r);
+                    prop_assert_eq!(frames, leg.link_frames(r.q));
+                }
+                None => prop_assert!(!r.reachable, "{r:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn exact_ik_refuses_non_finite_targets() {
+        let leg = littledog_leg(1.0, true);
+        assert!(leg.ik_exact([f64::NAN, 0.0, 0.0], None).is_none());
+        assert!(leg.ik_exact([0.0, f64::INFINITY, 0.0], None).is_none());
+        let (r, frames) = leg.ik_with_frames([f64::NAN, 0.0, 0.0], None);
+        assert_eq!(frames, leg.link_frames(r.q));
+        assert!(!r.reachable);
     }
 }
