@@ -98,6 +98,25 @@ def learned_available() -> str:
     return ""
 
 
+def learned_model_for(env_terrain: str, optimize_durations: bool) -> str:
+    """Why no learned model fits this benchmark's problem on ``env_terrain`` ("" when one does)."""
+    try:
+        from roughwalk.learning import ProblemSpec
+        from roughwalk.learning.initializer import model_for_spec
+
+        spec = ProblemSpec(
+            terrain=env_terrain,
+            gait=GAIT,
+            steps=STEPS,
+            duration=DURATION,
+            optimize_durations=optimize_durations,
+        )
+        model_for_spec("learned", spec)
+    except Exception as e:  # noqa: BLE001  (no model: run without it, and say why)
+        return f"{type(e).__name__}: {e}"
+    return ""
+
+
 def run_job(job: Job) -> dict[str, Any]:
     """Solve the job's task and execute the result; a plain dict (picklable)."""
     from roughwalk.robots import load_robot
@@ -282,6 +301,11 @@ def main() -> None:
             print(notes[-1])
         for init in inits:
             for opt in durations:
+                why = learned_model_for(terrain, opt) if init == "learned" else ""
+                if why:
+                    notes.append(f"{env}: learned initialiser skipped ({why})")
+                    print(notes[-1])
+                    continue
                 for it in iters:
                     for i, t in enumerate(tasks):
                         jobs.append(Job(env, terrain, init, it, opt, i, t.start, t.goal))

@@ -191,3 +191,26 @@ def test_contact_state_machine_early_late_flicker_and_slip():
     assert est.slipping.tolist() == [False, True, False, False]
     sm.update(0.22, planned, zero, [50.0, 30.0, 20.0, 100.0], speed)
     assert sm.counts["slip"] == 1
+
+
+def test_terrain_covering_pads_with_edge_heights_and_keeps_the_original():
+    terrain = load_terrain("single_pallet")
+    grown = terrain_covering(terrain, [[-2.0, 0.0], [1.0, 2.0]], margin=0.5)
+    x0, x1, y0, y1 = grown.extent
+    assert x0 <= -2.5 + 1e-9 and y1 >= 2.5 - 1e-9
+    xy = np.array([[0.0, 0.0], [1.2, 0.3], [2.0, -1.0]])
+    np.testing.assert_allclose(grown.height(xy), terrain.height(xy))
+    edge = terrain.height(np.array([[terrain.extent[0], 0.0]]))
+    np.testing.assert_allclose(grown.height(np.array([[-2.3, 0.0]])), edge)
+    assert terrain_covering(terrain, [[0.0, 0.0]], margin=0.5) is terrain
+
+
+def test_a_first_pose_out_of_reach_is_a_reported_failure_not_an_exception():
+    from roughwalk.tracking import execute_reference
+
+    robot = load_robot("anymal_c")
+    feet = np.array([[0.4, 0.3, 0.0], [0.4, -0.3, 0.0], [-0.4, 0.3, 0.0], [-0.4, -0.3, 0.0]])
+    reference = Reference.standing([0.0, 0.0, 1.5], feet, robot.mass)  # legs are 0.6 m long
+    outcome = execute_reference(reference, robot, load_terrain("flat"))
+    assert not outcome.success and outcome.reason.startswith("not started")
+    assert outcome.simulated_s == 0.0

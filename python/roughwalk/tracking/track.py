@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
-from roughwalk.errors import InvalidArgumentError, PlanningError
+from roughwalk.errors import InvalidArgumentError
 from roughwalk.tracking.config import TrackingConfig
 from roughwalk.tracking.controller import WholeBodyController, rotation_error, tracking_world
 from roughwalk.tracking.outcome import TrackingLog, TrackingOutcome
@@ -107,7 +107,9 @@ def execute_reference(
     samples = [reference(float(t)) for t in span]
     points = np.concatenate([np.vstack([s.feet_pos, s.base_pos[None]]) for s in samples])
     world = tracking_world(robot, terrain_covering(terrain, points), cfg)
-    _start(world, reference)
+    unreachable = _start(world, reference)
+    if unreachable:
+        return _not_started(reference, unreachable)
     controller = WholeBodyController(world, reference, cfg)
     outcome = _simulate(world, controller, reference, cfg, push)
     if video is not None and outcome.log is not None:
@@ -117,20 +119,47 @@ def execute_reference(
     return outcome
 
 
-def _start(world: World, reference: Reference) -> None:
-    """Put the robot at the reference's first pose, feet on their planned contact points."""
+def _not_started(reference: Reference, reason: str) -> TrackingOutcome:
+    """The outcome of a motion whose first pose the robot cannot take."""
+    nan = float("nan")
+    return TrackingOutcome(
+        success=False,
+        reason=reason,
+        final_position_error_m=nan,
+        max_orientation_error_rad=nan,
+        mean_position_error_m=nan,
+        max_position_error_m=nan,
+        mean_orientation_error_rad=nan,
+        fell=False,
+        fall_time_s=None,
+        duration_s=reference.duration,
+        simulated_s=0.0,
+        qp_failures=0,
+        early_touchdowns=0,
+        late_touchdowns=0,
+        slips=0,
+        mean_qp_time_ms=0.0,
+    )
+
+
+def _start(world: World, reference: Reference) -> str:
+    """Put the robot at the reference's first pose, feet on their planned contact points.
+
+    Returns why it cannot ("" when it can).
+    """
     robot = world.robot
     first = reference(0.0)
     quat = first.base_quat
     centres = first.feet_pos + np.array([0.0, 0.0, robot.foot_radius])
     q, reachable = robot.inverse_kinematics(centres, first.base_pos, quat)
     if not reachable.all():
-        raise PlanningError(
-            f"the motion's first pose cannot be reached by robot '{robot.name}' "
+        return (
+            f"not started: robot '{robot.name}' cannot take the motion's first pose "
             f"(legs {np.flatnonzero(~reachable).tolist()} out of reach)"
         )
     world.reset(q, first.base_pos, quat)
     world.data.ctrl[:] = 0.0
+    return ""
 
 
 def _simulate(
