@@ -402,3 +402,17 @@ def center_of_mass_batch(
     base_com: ArrayLike,
 ) -> NDArray[np.float64]:
     """Whole-robot CoM (N, 3) in the base frame [m] for joint angles (N, 4, 3) [rad]."""
+
+def capsule_clearances(
+    quadruped: Quadruped,
+    sdf: SdfField,
+    leg: ArrayLike,
+    link: ArrayLike,
+    a: ArrayLike,
+    b: ArrayLike,
+    radius: ArrayLike,
+    q: ArrayLike,
+    base_pos: ArrayLike,
+    rotation: ArrayLike,
+) -> NDArray[np.float64]:
+    """Clearances (N, P) [m] of collision capsules at N configurations (q (N, 4, 3) [rad])."""

@@ -24,6 +24,7 @@ from roughwalk.trajectories.body_pass import DAMPING, BodyPass, resolve_backend
 from roughwalk.trajectories.chomp import Evaluation
 from roughwalk.trajectories.costs.obstacle import ObstacleCost
 from roughwalk.trajectories.generator import FootstepTrajectoryGenerator
+from roughwalk.trajectories.step_report import capsule_clearances, capsule_clearances_numpy
 from roughwalk.trajectories.swing_pass import SwingPass
 
 
@@ -164,3 +165,15 @@ def test_batched_com_and_feet_equal_the_numpy_link_frames(barrier) -> None:
     np.testing.assert_allclose(
         wb.foot_positions(q), wb.foot_positions(q, frames), rtol=0, atol=1e-12
     )
+
+
+def test_capsule_clearances_equal_the_numpy_reference(barrier) -> None:
+    gen, state = barrier
+    rng = np.random.default_rng(6)
+    q = state.q + 0.1 * rng.normal(size=state.q.shape)
+    args = (gen.wb, gen.sdf, q, state.body[:, :3], state.rotation)
+    rust = capsule_clearances(*args)
+    numpy = capsule_clearances_numpy(*args)
+    assert rust.shape == numpy.shape == (state.n_samples, len(gen.wb.collision))
+    assert numpy.min() < 0.01  # the barrier is near
+    np.testing.assert_allclose(rust, numpy, rtol=0, atol=1e-12)

@@ -9,8 +9,8 @@ use roughwalk_core::kinematics::math::{Mat3, Vec3};
 use roughwalk_core::trajectory::body_pass::BodyPassSetup;
 use roughwalk_core::trajectory::swing_pass::SwingPassSetup;
 use roughwalk_core::trajectory::{
-    center_of_mass_batch, BodyPass, BodyPoints, GradientMode, MassDistribution, ObstacleTerm,
-    SwingPass, ZmpSupport,
+    capsule_clearances, center_of_mass_batch, BodyPass, BodyPoints, GradientMode, LinkCapsules,
+    MassDistribution, ObstacleTerm, SwingPass, ZmpSupport,
 };
 use roughwalk_core::CoreError;
 
@@ -375,8 +375,57 @@ fn center_of_mass_batch_py<'py>(
     array(py, com.concat(), &[q.len(), 3])
 }
 
-/// Adds the pass evaluators and the CoM batch to the module.
+/// Clearances (N, P) [m] of P collision capsules (leg −1 = trunk, link, ends
+/// a and b (P, 3) in their link's frame [m], radii (P,)) at N configurations:
+/// joint angles (N, 4, 3) [rad], trunk positions (N, 3) [m], orientations (N, 3, 3).
+#[pyfunction]
+#[pyo3(name = "capsule_clearances")]
+fn capsule_clearances_py<'py>(
+    py: Python<'py>,
+    quadruped: PyRef<'py, PyQuadruped>,
+    sdf: PyRef<'py, PySdfField>,
+    leg: ArrayIn<'py>,
+    link: ArrayIn<'py>,
+    a: ArrayIn<'py>,
+    b: ArrayIn<'py>,
+    radius: ArrayIn<'py>,
+    q: ArrayIn<'py>,
+    base_pos: ArrayIn<'py>,
+    rotation: ArrayIn<'py>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let leg = read(&leg, "capsule legs", &[None])?;
+    let p = leg.len();
+    let link = read(&link, "capsule links", &[Some(p)])?;
+    let a = vec3_rows(&read(&a, "capsule ends a", &[Some(p), Some(3)])?);
+    let b = vec3_rows(&read(&b, "capsule ends b", &[Some(p), Some(3)])?);
+    let radius = read(&radius, "capsule radii", &[Some(p)])?;
+    let capsules = LinkCapsules::new(
+        &leg.iter().map(|&v| v as i64).collect::<Vec<_>>(),
+        &link.iter().map(|&v| v as i64).collect::<Vec<_>>(),
+        a,
+        b,
+        radius,
+    )
+    .py()?;
+    let q = rows::<12>(&read(&q, "q", &[None, Some(4), Some(3)])?);
+    let n = q.len();
+    let base_pos = vec3_rows(&read(&base_pos, "base_pos", &[Some(n), Some(3)])?);
+    let rotation: Vec<Mat3> =
+        rows::<9>(&read(&rotation, "rotation", &[Some(n), Some(3), Some(3)])?)
+            .iter()
+            .map(|r| [[r[0], r[1], r[2]], [r[3], r[4], r[5]], [r[6], r[7], r[8]]])
+            .collect();
+    let robot = &quadruped.inner;
+    let field = &sdf.inner;
+    let d = py
+        .detach(|| capsule_clearances(robot, &capsules, field, &q, &base_pos, &rotation))
+        .py()?;
+    array(py, d, &[n, p])
+}
+
+/// Adds the pass evaluators and the CoM and clearance batches to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(capsule_clearances_py, m)?)?;
     m.add_class::<PyBodyPassEvaluator>()?;
     m.add_class::<PySwingPassEvaluator>()?;
     m.add_function(wrap_pyfunction!(center_of_mass_batch_py, m)?)?;

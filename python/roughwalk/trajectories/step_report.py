@@ -17,11 +17,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from roughwalk import _core
 from roughwalk.robots.canonical_frame import LEG_NAMES
+from roughwalk.trajectories.body_pass import compiled_field
 from roughwalk.trajectories.config import ValidityConfig
 from roughwalk.trajectories.whole_body import LINK_NAMES, WholeBody
 
-__all__ = ["StepReport", "capsule_clearances", "primitive_names"]
+__all__ = ["StepReport", "capsule_clearances", "capsule_clearances_numpy", "primitive_names"]
 
 
 @dataclass(frozen=True)
@@ -95,7 +97,36 @@ def capsule_clearances(
     base_pos: NDArray[np.float64],
     rotation: NDArray[np.float64],
 ) -> NDArray[np.float64]:
-    """Clearance (n, P) [m] of every collision primitive at n configurations (SDF capsule query)."""
+    """Clearance (n, P) [m] of every collision primitive at n configurations (SDF capsule query).
+
+    One Rust call when ``sdf`` is the compiled field; numpy otherwise (and as its reference).
+    """
+    cm = wb.collision
+    core_field = compiled_field(sdf)
+    if core_field is not None:
+        return _core.capsule_clearances(
+            wb.core,
+            core_field,
+            cm.leg,
+            cm.link,
+            cm.a,
+            cm.b,
+            cm.radius,
+            np.asarray(q, dtype=float).reshape(-1, 4, 3),
+            base_pos,
+            rotation,
+        )
+    return capsule_clearances_numpy(wb, sdf, q, base_pos, rotation)
+
+
+def capsule_clearances_numpy(
+    wb: WholeBody,
+    sdf: Any,
+    q: NDArray[np.float64],
+    base_pos: NDArray[np.float64],
+    rotation: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """:func:`capsule_clearances` over numpy link frames and any ``query_capsules`` field."""
     cm = wb.collision
     positions, rotations, _, _ = wb.link_frames(q)
     leg = np.maximum(cm.leg, 0)

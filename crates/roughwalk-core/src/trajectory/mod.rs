@@ -11,6 +11,7 @@
 
 pub mod body_pass;
 pub mod body_points;
+pub mod capsule_clearance;
 pub mod center_of_mass;
 pub mod obstacle;
 pub mod rpy;
@@ -19,6 +20,7 @@ pub mod zmp_support;
 
 pub use body_pass::{BodyPass, BodyPassEvaluation};
 pub use body_points::BodyPoints;
+pub use capsule_clearance::{capsule_clearances, LinkCapsules};
 pub use center_of_mass::{center_of_mass_batch, MassDistribution};
 pub use obstacle::{obstacle_potential, DistanceQuery, GradientMode, ObstacleTerm};
 pub use swing_pass::{SwingPass, SwingPassEvaluation};
