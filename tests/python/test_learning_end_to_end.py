@@ -72,3 +72,62 @@ def test_iteration_rounds_write_models_that_reload(experience: Path, tmp_path: P
     assert resolved is not None and len(resolved) == 12
     assert int(resolved["iterations"].max()) <= 25
     assert filter_good(resolved, rounds[0].train.g_max).n_good >= 10
+
+
+def test_cli_trains_a_model_that_optimize_uses(experience: Path, tmp_path: Path) -> None:
+    from roughwalk.cli.main import main
+
+    model = tmp_path / "cli.npz"
+    args = [
+        "init",
+        "train",
+        str(experience),
+        "--out",
+        str(model),
+        "--layers",
+        "8",
+        "--max-epochs",
+        "50",
+    ]
+    assert main(args) == 0
+    assert LearnedModel.load(model).header["training"]["n_tasks"] == 40
+    out = tmp_path / "result.json"
+    code = main(
+        [
+            "optimize",
+            "--terrain",
+            "flat",
+            "--steps",
+            "4",
+            "--duration",
+            "2",
+            "--start=0,0,0",
+            "--goal",
+            "0.4,0,0",
+            "--init",
+            f"learned:{model}",
+            "--json",
+            str(out),
+        ]
+    )
+    assert code == 0 and out.is_file()
+    # The same model on another step count is refused, naming it.
+    assert (
+        main(
+            [
+                "optimize",
+                "--terrain",
+                "flat",
+                "--steps",
+                "8",
+                "--duration",
+                "2",
+                "--start=0,0,0",
+                "--goal",
+                "0.4,0,0",
+                "--init",
+                f"learned:{model}",
+            ]
+        )
+        == 1
+    )
