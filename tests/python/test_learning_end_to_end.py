@@ -9,6 +9,7 @@ heuristic, to the same optimum.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -46,7 +47,7 @@ def test_learned_init_converges_in_fewer_iterations_on_held_out_tasks(
     model, report = train_model(data, layers=(16, 16), max_epochs=300)
     assert report.n_good >= 20, report.summary()
     path = model.save(tmp_path / "tiny.npz")
-    options = {"gait": "walk", "steps": 4, "duration": 2.0, "max_iter": LIMIT}
+    options: dict[str, Any] = {"gait": "walk", "steps": 4, "duration": 2.0, "max_iter": LIMIT}
     iterations: dict[str, list[int]] = {"heuristic": [], f"learned:{path}": []}
     for i in range(6):
         task = SPACE.task(i, split="test")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import zipfile
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -60,13 +61,13 @@ def test_model_file_holds_arrays_only_and_predicts_the_same_after_reload(tmp_pat
     ],
 )
 def test_model_applied_to_another_robot_gait_or_step_count_is_refused(
-    tmp_path: Path, options: dict[str, object], named: str
+    tmp_path: Path, options: dict[str, Any], named: str
 ) -> None:
     nlp = build_problem(SPEC).formulation
     path = _model(nlp.n_variables, problem_signature(nlp)["layout"], np.random.default_rng(2)).save(
         tmp_path / "walk4.npz"
     )
-    problem = {"gait": "walk", "steps": 4, "duration": 2.0, **options}
+    problem: dict[str, Any] = {"gait": "walk", "steps": 4, "duration": 2.0, **options}
     robot = problem.pop("robot", "anymal_c")
     with pytest.raises(ConfigError, match=f"learned model 'walk4' does not fit.*{named}"):
         roughwalk.optimize_motion(
