@@ -162,7 +162,7 @@ def fit_mlp(
     _, sv, vt = np.linalg.svd(z, full_matrices=False)
     energy = np.cumsum(sv**2) / max(float(np.sum(sv**2)), 1e-300)
     keep = min(int(np.searchsorted(energy, 0.999)) + 1, max_components, len(sv))
-    basis = vt[: max(keep, 1)]
+    basis = vt[: max(keep, min(2, len(sv)))]  # two at least: sklearn wants 2-D targets
     with warnings.catch_warnings():
         # max_epochs is a budget, not a promise of convergence.
         warnings.simplefilter("ignore", ConvergenceWarning)
