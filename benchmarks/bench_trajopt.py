@@ -5,17 +5,20 @@ Two families of tasks (issue 8):
 * Melon et al.'s (ICRA 2020, §V), with their costs and constraints
   (``melon_config``): flat ground 1.5 m in 3.5 s trotting (14 steps), the
   single pallet (from 0.5–1.5 m before its edge to (1.6, 0) on top) and the
-  double pallet (to (1.8, 0) on the upper level), walking 16 steps in 5.5 s;
+  double pallet (to (1.8, 0) on the upper level), walking 16 steps in 5.5 s,
+  and the single pallet with optimised phase durations;
 * TOWR's own test tasks (``towr_config``: TOWR 1.4's feasibility problem with
-  its ANYmal values), T = 3.5 s, goals 1.0–2.5 m ahead on flat ground and
-  TOWR's block, stairs, gap and slope, with fixed and optimised phase durations.
+  its ANYmal values and IPOPT tolerances), T = 3.5 s, 16-step gaits as TOWR's
+  figures were measured, goals 1.0–2.5 m ahead on flat ground and TOWR's
+  block, stairs, gap and slope, with fixed and optimised phase durations.
 
 Every task runs ``--runs`` times: the first run builds the NLP (its time is
 "cold", building included), the next ones reuse it ("warm", the median is
 shown), as a planner solving many tasks on one terrain would. TOWR 1.4's
 figures measured on this machine kind (issue 8; IPOPT 3.11.9 + MUMPS, exact
 Jacobians, L-BFGS Hessian, 40 s CPU limit, medians of 3 runs) are printed
-beside ours. The time limit is TOWR's 40 s.
+beside ours. The time limit is TOWR's 40 s. Wall times on a shared machine
+depend on its load, so the process CPU time of each solve is recorded too.
 
 Run: ``python3 benchmarks/bench_trajopt.py [--quick] [--runs N]`` or
 ``roughwalk bench trajopt``. Writes ``benchmarks/results/trajopt.json``.
@@ -26,6 +29,7 @@ from __future__ import annotations
 import argparse
 import math
 import statistics
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -63,11 +67,13 @@ CASES = [
     Case("single pallet, 0.5 m before", "melon", "single_pallet", (1.6, 0, 0), "walk", 16, 5.5,
          start=(0.5, -0.2, -0.3)),
     Case("double pallet", "melon", "double_pallet", (1.8, 0, 0), "walk", 16, 5.5, quick=True),
+    Case("single pallet, 1.0 m before, opt. durations", "melon", "single_pallet", (1.6, 0, 0),
+         "walk", 16, 5.5, True),
     Case("flat walk 1.5 m", "towr", "flat", (1.5, 0, 0), "walk", 16, 3.5,
          towr="17 it, 0.54–0.62 s", quick=True),
     Case("flat walk 1.5 m, opt. durations", "towr", "flat", (1.5, 0, 0), "walk", 16, 3.5, True,
          towr="1.45 s"),
-    Case("flat trot 1.5 m", "towr", "flat", (1.5, 0, 0), "trot", 14, 3.5,
+    Case("flat trot 1.5 m", "towr", "flat", (1.5, 0, 0), "trot", 16, 3.5,
          towr="13 it, 0.42–0.49 s", quick=True),
     Case("block, goal 1.0 m", "towr", "towr_block", (1.0, 0, 0), "walk", 16, 3.5,
          towr="22–64 it, 0.66–1.9 s"),
@@ -85,9 +91,9 @@ CASES = [
          towr="0.64–0.90 s"),
     Case("gap, goal 2.0 m, walk", "towr", "towr_gap", (2.0, 0, 0), "walk", 16, 3.5,
          towr="fails (40 s limit)", quick=True),
-    Case("gap, goal 2.5 m, trot", "towr", "towr_gap", (2.5, 0, 0), "trot", 14, 3.5,
+    Case("gap, goal 2.5 m, trot", "towr", "towr_gap", (2.5, 0, 0), "trot", 16, 3.5,
          towr="fails (one opt. run: 23 s)"),
-    Case("gap, goal 2.0 m, bound", "towr", "towr_gap", (2.0, 0, 0), "bound", 14, 3.5,
+    Case("gap, goal 2.0 m, bound", "towr", "towr_gap", (2.0, 0, 0), "bound", 16, 3.5,
          towr="3.5–37.5 s"),
     Case("slope, goal 2.0 m", "towr", "towr_slope", (2.0, 0, 0), "walk", 16, 3.5),
 ]  # fmt: skip
@@ -103,14 +109,18 @@ def run_case(case: Case, runs: int) -> dict[str, Any]:
         body_model="towr_anymal", optimize_durations=case.optimize_durations
     )
     results: list[TrajoptResult] = []
+    cpu: list[float] = []
     for _ in range(runs):
+        start = time.process_time()
         r = optimize_motion(
             None, case.terrain, (case.start, case.goal), config=config, gait=case.gait,
             steps=case.steps, duration=case.duration, **case.options,
         )  # fmt: skip
+        cpu.append(time.process_time() - start)
         results.append(r)
     cold = results[0]
     warm = results[1:] or results
+    warm_cpu = cpu[1:] or cpu
     return {
         "name": case.name,
         "family": case.family,
@@ -128,6 +138,8 @@ def run_case(case: Case, runs: int) -> dict[str, Any]:
         "cold_total_s": cold.solve_time_s,
         "build_s": cold.build_time_s,
         "warm_total_s": statistics.median(r.solve_time_s for r in warm),
+        "cold_cpu_s": cpu[0],
+        "warm_cpu_s": statistics.median(warm_cpu),
         "objective": _finite(cold.objective),
         "max_violation": _finite(cold.max_violation),
         "n_variables": cold.n_variables,
@@ -139,7 +151,7 @@ def print_table(rows: list[dict[str, Any]]) -> None:
     """The results, one line per task, TOWR's figure last."""
     head = (
         f"{'task':<44} {'status':<11} {'iter':>5} {'ms/it':>7} {'warm s':>7} {'cold s':>7} "
-        f"{'build s':>7} {'vars':>5}  TOWR 1.4"
+        f"{'build s':>7} {'cpu w/c':>11} {'vars':>5}  TOWR 1.4"
     )
     family = None
     for row in rows:
@@ -150,7 +162,8 @@ def print_table(rows: list[dict[str, Any]]) -> None:
         print(
             f"{row['name']:<44} {row['status']:<11} {row['iterations']:>5} "
             f"{row['ms_per_iteration']:>7.1f} {row['warm_total_s']:>7.2f} "
-            f"{row['cold_total_s']:>7.2f} {row['build_s']:>7.2f} {row['n_variables']:>5}  "
+            f"{row['cold_total_s']:>7.2f} {row['build_s']:>7.2f} "
+            f"{row['warm_cpu_s']:>5.2f}/{row['cold_cpu_s']:<5.2f} {row['n_variables']:>5}  "
             f"{row['towr']}"
         )
 
