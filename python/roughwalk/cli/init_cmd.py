@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -174,6 +175,7 @@ def cmd_iterate(args: argparse.Namespace) -> int:
         g_max=args.g_max,
         seed=args.seed,
         executor=executor,
+        progress=sys.stderr,
     )
     for r in rounds:
         print(r.summary())
