@@ -37,8 +37,12 @@ class TrackingGains:
         Swing-foot feedback [1/s²], [1/s]: stiffer than the base, a swing leg
         is light and must land where planned.
     slip_gain_scale:
-        Factor on the stance-foot weight and on the base gains while a foot
-        slips: holding the foot harder is what stops a slip.
+        Factor on a slipping foot's stance weight (with soft contacts):
+        holding the foot harder is what stops a slip.
+    slip_friction_scale:
+        Factor on μ in a slipping foot's friction pyramid: ask it for less
+        tangential force. (Raising the base gains on a slip, tried first,
+        turned each slip into a jolt.)
     foothold_velocity_gain:
         Swing feet land this many seconds [s] of base velocity error further
         along (the capture point's √(h/g) ≈ 0.22 s for ANYmal C): the one
@@ -48,6 +52,11 @@ class TrackingGains:
         Fraction of the base position error added to the footholds.
     max_foothold_shift_m:
         Largest foothold correction [m].
+    max_base_feedback:
+        Largest base (or CoM) feedback acceleration [m/s²]: a big error is
+        closed over several steps, not with a lunge that makes the feet slide.
+    max_orientation_feedback:
+        Largest base orientation feedback acceleration [rad/s²].
     max_swing_feedback:
         Largest swing-foot feedback acceleration [m/s²]: a far-off foot must
         not whip its leg, whose reaction spins a trunk in flight.
@@ -60,15 +69,24 @@ class TrackingGains:
     swing_kp: float = 400.0
     swing_kd: float = 40.0
     slip_gain_scale: float = 3.0
+    slip_friction_scale: float = 0.5
     foothold_velocity_gain: float = 0.22
     foothold_position_gain: float = 0.5
     max_foothold_shift_m: float = 0.12
     max_swing_feedback: float = 25.0
+    max_base_feedback: float = 50.0
+    max_orientation_feedback: float = 100.0
 
     def __post_init__(self) -> None:
         _positive(
             self,
-            tuple(self.__dataclass_fields__)[:7] + ("max_foothold_shift_m", "max_swing_feedback"),
+            tuple(self.__dataclass_fields__)[:8]
+            + (
+                "max_foothold_shift_m",
+                "max_swing_feedback",
+                "max_base_feedback",
+                "max_orientation_feedback",
+            ),
             "gains",
         )
         if not (self.foothold_velocity_gain >= 0 and self.foothold_position_gain >= 0):

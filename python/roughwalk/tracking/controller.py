@@ -70,6 +70,12 @@ def _full_mass_matrix(m: mujoco.MjModel, d: mujoco.MjData, out: NDArray[np.float
         mujoco.mj_fullM(m, d, out)
 
 
+def _capped(v: NDArray[np.float64], limit: float) -> NDArray[np.float64]:
+    """``v`` scaled down to norm ``limit`` when longer."""
+    size = float(np.linalg.norm(v))
+    return v * (limit / size) if size > limit else v
+
+
 def rotation_error(r_ref: NDArray[np.float64], r: NDArray[np.float64]) -> NDArray[np.float64]:
     """Rotation vector [rad] (world axes) that turns R into R_ref: log(R_ref Rᵀ)."""
     e = r_ref @ r.T
@@ -188,7 +194,11 @@ class WholeBodyController:
         tasks = self._tasks(layout, state, ref, estimate, stance, points, foot_vel, jac, bias)
         jc = jac[stance].reshape(-1, self.nv)
         hard = bias[stance].ravel() if self.config.hard_contacts else None
-        solution = self.qp.solve(self._mass, h, jc, tasks, contact_bias=hard)
+        friction = (
+            np.where(estimate.slipping[stance], self.config.gains.slip_friction_scale, 1.0)
+            * self.config.friction
+        )
+        solution = self.qp.solve(self._mass, h, jc, tasks, contact_bias=hard, friction=friction)
         qp_forces = np.zeros((4, 3))
         if solution.success:
             self.torques = solution.tau
@@ -257,20 +267,18 @@ class WholeBodyController:
         assert isinstance(layout, QPLayout)
         cfg, g, w = self.config, self.config.gains, self.config.weights
         d = self.world.data
-        slip = bool(estimate.slipping.any())
-        scale = g.slip_gain_scale if slip else 1.0
         # Melon 2020 §V: track the optimised base pose and twist (feedforward
         # acceleration + PD), the swing feet, and the planned contact forces.
-        a_lin = (
-            ref.base_acc
-            + scale * g.base_kp * (ref.base_pos - state.base_pos)
-            + g.base_kd * (ref.base_vel - state.base_vel)
+        a_lin = ref.base_acc + _capped(
+            g.base_kp * (ref.base_pos - state.base_pos)
+            + g.base_kd * (ref.base_vel - state.base_vel),
+            g.max_base_feedback,
         )
         r = state.rotation
-        a_ang = (
-            ref.base_angacc
-            + scale * g.orientation_kp * rotation_error(ref.base_rot, r)
-            + g.orientation_kd * (ref.base_angvel - state.base_angvel)
+        a_ang = ref.base_angacc + _capped(
+            g.orientation_kp * rotation_error(ref.base_rot, r)
+            + g.orientation_kd * (ref.base_angvel - state.base_angvel),
+            g.max_orientation_feedback,
         )
         # The free joint's q̈[0:3] is the base origin's world acceleration and
         # q̈[3:6] the body-frame angular acceleration, so R q̈[3:6] = ω̇ (world).
@@ -287,10 +295,9 @@ class WholeBodyController:
             # exactly for the whole robot's centre of mass (not for the trunk,
             # which swinging legs push around): track the planned c itself.
             j_lin, bias_lin, com, com_vel = self._com_jacobian()
-            a_lin = (
-                ref.com_acc
-                + scale * g.base_kp * (ref.com_pos - com)
-                + g.base_kd * (ref.com_vel - com_vel)
+            a_lin = ref.com_acc + _capped(
+                g.base_kp * (ref.com_pos - com) + g.base_kd * (ref.com_vel - com_vel),
+                g.max_base_feedback,
             )
         trunk = quat_to_matrix(d.qpos[3:7])
         j_ang = np.zeros((3, self.nv))
@@ -339,13 +346,10 @@ class WholeBodyController:
                 target = target - depth * _Z
                 target_vel = -c.search_speed_m_s * _Z if depth < c.search_depth_m else np.zeros(3)
                 target_acc = np.zeros(3)
-            feedback = g.swing_kp * (target - points[leg]) + g.swing_kd * (
-                target_vel - foot_vel[leg]
+            a_foot = target_acc + _capped(
+                g.swing_kp * (target - points[leg]) + g.swing_kd * (target_vel - foot_vel[leg]),
+                g.max_swing_feedback,
             )
-            size = float(np.linalg.norm(feedback))
-            if size > g.max_swing_feedback:
-                feedback *= g.max_swing_feedback / size
-            a_foot = target_acc + feedback
             tasks.append(
                 motion_task(f"swing_foot {leg}", layout, jac[leg], bias[leg], a_foot, w.swing_foot)
             )

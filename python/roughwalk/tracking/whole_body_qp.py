@@ -120,6 +120,7 @@ class WholeBodyQP:
         tasks: Sequence[LeastSquaresTask],
         normals: ArrayLike | None = None,
         contact_bias: ArrayLike | None = None,
+        friction: ArrayLike | None = None,
     ) -> QPSolution:
         """Minimise Σ w‖A x − b‖² subject to dynamics, friction and torque limits.
 
@@ -138,6 +139,8 @@ class WholeBodyQP:
         contact_bias:
             (3·nc,) J̇_c q̇ [m/s²]: when given, the stance feet do not accelerate,
             J_c q̈ + J̇_c q̇ = 0, as a hard constraint (else it is up to the tasks).
+        friction:
+            (nc,) μ per stance foot (default: the solver's μ for all).
         """
         m = np.asarray(mass_matrix, dtype=float)
         h = np.asarray(bias, dtype=float)
@@ -147,6 +150,7 @@ class WholeBodyQP:
         lay = self.layout(nv, nc)
         n = lay.size
         nrm = np.tile([0.0, 0.0, 1.0], (nc, 1)) if normals is None else np.asarray(normals)
+        mu = np.full(nc, self.friction) if friction is None else np.asarray(friction, dtype=float)
 
         # M q̈ − Sᵀτ − J_cᵀ f = −h
         a_eq = np.zeros((nv, n))
@@ -170,7 +174,7 @@ class WholeBodyQP:
         for i in range(nc):
             normal = nrm[i] / np.linalg.norm(nrm[i])
             rows = np.zeros((6, n))
-            rows[:4, lay.force(i)] = friction_pyramid(normal, self.friction)
+            rows[:4, lay.force(i)] = friction_pyramid(normal, float(mu[i]))
             rows[4, lay.force(i)] = -normal
             rows[5, lay.force(i)] = normal
             g_rows.append(rows)
