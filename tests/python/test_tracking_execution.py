@@ -95,13 +95,22 @@ def _base_leap(result: TrajoptResult, lateral_m: float) -> TrajoptResult:
     return dataclasses.replace(result, splines=splines)
 
 
-def test_a_dynamically_infeasible_trajectory_is_a_reported_failure(trot):
-    outcome = track(_base_leap(trot, 0.4))
-    assert not outcome.success
-    assert outcome.reason.split(":")[0] in ("fell", "missed the goal")
-    data = outcome.to_dict()
-    json.dumps(data)
-    assert data["success"] is False and data["reason"] == outcome.reason
+def test_a_dynamically_infeasible_trajectory_is_a_reported_failure(trot, tmp_path):
+    """Through the CLI: exit code 1, a JSON verdict with its reason, and the Figure-4 picture."""
+    from roughwalk.cli.main import main
+
+    path = tmp_path / "leap.json"
+    data = {"schema": "trajopt_result", "robot": "anymal_c", "terrain": "flat"}
+    path.write_text(json.dumps({**data, **_base_leap(trot, 0.4).to_dict()}))
+    out, picture = tmp_path / "out.json", tmp_path / "tracking.png"
+    code = main(["track", "--trajectory", str(path), "--json", str(out), "-o", str(picture)])
+    assert code == 1
+    verdict = json.loads(out.read_text())
+    assert verdict["schema"] == "tracking_outcome" and verdict["success"] is False
+    assert verdict["reason"].split(":")[0] in ("fell", "missed the goal")
+    for key in ("final_position_error_m", "max_orientation_error_rad", "mean_position_error_m"):
+        assert key in verdict
+    assert picture.stat().st_size > 10_000
 
 
 def test_reference_matches_the_splines_and_its_derivatives(trot):
