@@ -224,3 +224,13 @@ def test_initialisers_by_name_and_the_learned_plug_in_point() -> None:
         registry._REGISTRY.pop("learned", None)
         if learned is not None:
             registry._REGISTRY["learned"] = learned
+
+
+def test_ipopt_options_are_part_of_the_structure_key() -> None:
+    # A cached problem carries the IPOPT options it was built with; another set must not reuse it.
+    from roughwalk.trajopt.parameters import SolverOptions, TrajoptConfig
+
+    plain = TrajoptConfig()
+    adaptive = TrajoptConfig(solver=SolverOptions(ipopt_options=("mu_strategy=adaptive",)))
+    assert plain.structure_key() != adaptive.structure_key()
+    assert plain.structure_key() == TrajoptConfig().structure_key()

@@ -359,6 +359,9 @@ class TrajoptConfig:
             self.solver.linear_solver,
             self.solver.mumps_pivot_order,
             self.solver.print_level,
+            # IPOPT's options are fixed when the solver is built, so a cached problem
+            # built with other options must not be reused.
+            self.solver.ipopt_options,
         )
 
 
