@@ -52,3 +52,11 @@ def test_optimize_bad_task_reports_a_status(tmp_path: Path, capsys) -> None:
     assert "too short" in data["message"] and "invalid_input" in capsys.readouterr().out
     assert main([*FLAGS[:-1], "--start", "0,0"]) == 1
     assert "--start must be X,Y,YAW" in capsys.readouterr().err
+
+
+def test_a_named_body_model_still_names_the_robot_that_executes_it(tmp_path: Path) -> None:
+    # `roughwalk track` loads the JSON's robot: TOWR's body parameters are not a robot.
+    out = tmp_path / "towr.json"
+    assert main([*FLAGS, "--set", "body_model=towr_anymal", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["robot"] == "anymal_c" and data["body_model"] == "towr_anymal"

@@ -86,6 +86,11 @@ def cmd_optimize(args: argparse.Namespace) -> int:
     if args.json:
         data = result.to_dict(npz=args.npz)
         robot_name = data.pop("robot", None) or result.robot
+        if config.body_model != "robot":
+            # A named body model (towr_anymal) is not a robot: the JSON names the robot
+            # that executes the motion (`roughwalk track` loads it) and the body separately.
+            robot_name = args.robot
+            data["body_model"] = config.body_model
         write_json(
             args.json,
             result_envelope("trajopt_result", robot=robot_name, terrain=terrain.spec, **data),
