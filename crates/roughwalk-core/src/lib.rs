@@ -11,9 +11,9 @@ pub mod heightfield;
 pub mod kinematics;
 pub mod sdf;
 pub mod search;
-pub mod trajectory;
 #[doc(hidden)]
 pub mod testing;
+pub mod trajectory;
 
 pub use error::{CoreError, CoreResult};
 pub use heightfield::{HeightField, Interpolation};
