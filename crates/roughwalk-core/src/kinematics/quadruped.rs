@@ -172,21 +172,9 @@ impl Quadruped {
 #[allow(clippy::float_cmp)]
 pub(crate) mod tests {
     use super::*;
-    use crate::kinematics::leg::tests::littledog_leg;
     use crate::kinematics::math::norm;
-
-    pub fn littledog() -> Quadruped {
-        Quadruped::new([
-            littledog_leg(1.0, true),
-            littledog_leg(-1.0, true),
-            littledog_leg(1.0, false),
-            littledog_leg(-1.0, false),
-        ])
-    }
-
-    pub const STANCE_Q: [f64; 12] = [
-        0.05, 0.6, -1.1, -0.05, 0.6, -1.1, 0.05, -0.6, 1.1, -0.05, -0.6, 1.1,
-    ];
+    // One LittleDog for every test and bench: the shared fixture.
+    pub use crate::testing::{littledog, STANCE_Q};
 
     #[test]
     fn world_ik_inverts_world_fk_and_batches_agree() {
