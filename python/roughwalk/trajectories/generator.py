@@ -28,7 +28,11 @@ from roughwalk.trajectories.body_pass import BACKENDS, BodyPass
 from roughwalk.trajectories.chomp import Chomp, ChompStatus
 from roughwalk.trajectories.config import TrajectoryConfig
 from roughwalk.trajectories.costs.obstacle import ObstacleCost
-from roughwalk.trajectories.footstep_trajectory import FootstepTrajectory, resample_footstep
+from roughwalk.trajectories.footstep_trajectory import (
+    FootstepTrajectory,
+    resample_footstep,
+    swing_speed_ratio,
+)
 from roughwalk.trajectories.initial_trajectory import (
     FootstepState,
     StartState,
@@ -57,6 +61,15 @@ EXIT_MARGIN_FACTOR = 2.0
 """Where each swing leaves the ZMP, in multiples of the support term's margin inside
 its triangle: the preview controller lags its reference, and the ZMP must still be
 inside when the foot lands."""
+
+
+RETIME_MARGIN = 1.02
+"""A swing whose initial trajectory breaks a velocity limit by the factor r is
+lengthened by r times this before CHOMP: the trunk's preview motion does not
+scale exactly with the step's duration."""
+
+RETIME_LIMIT = 3
+"""Most re-timings of one initial trajectory before CHOMP is run on it anyway."""
 
 
 @dataclass(frozen=True)
@@ -387,6 +400,40 @@ class FootstepTrajectoryGenerator:
         state.contact_clearance = min(float(np.min(d)), 0.0)
         return state
 
+    def _retimed(
+        self,
+        prepared: PreparedPlan,
+        k: int,
+        start: StartState,
+        use_shortcut: bool,
+        scale: float,
+        stretch: float,
+    ) -> tuple[FootstepState, float]:
+        """The initial trajectory of step k, lengthened until its swing keeps the velocity limits.
+
+        The nominal timing (§5.2) sees the swing leg under a still trunk; the
+        preview controller moves the trunk during the swing, and the swing leg
+        can then outrun a joint's limit by up to ~20 % (LittleDog boards A, C,
+        Y). CHOMP's joint-speed term rarely recovers that, and the restart
+        (§5.3) came only after its whole iteration budget, twice. Measuring the
+        swing's peak joint speed on the initial trajectory and stretching the
+        step by the excess costs one more initial trajectory instead.
+        Returns the state and the stretch factor (≥ 1) later attempts keep.
+        """
+        cfg = self.config
+        state = self.initial_state(prepared, k, start, use_shortcut, scale * stretch)
+        for _ in range(RETIME_LIMIT):
+            ratio = swing_speed_ratio(state, self.wb, cfg.control_rate_hz)
+            if ratio <= 1.0:
+                break
+            longer = stretch * ratio * RETIME_MARGIN
+            timing = prepared.timings[k].scaled(scale * longer)
+            if timing.shift_s + timing.swing_s > cfg.timing.max_step_s:
+                break
+            stretch = longer
+            state = self.initial_state(prepared, k, start, use_shortcut, scale * stretch)
+        return state, stretch
+
     @staticmethod
     def _worth_restarting(
         result: FootstepTrajectory, previous: FootstepTrajectory | None, was_shortcut: bool
@@ -434,11 +481,12 @@ class FootstepTrajectoryGenerator:
             result: FootstepTrajectory | None = None
             previous: FootstepTrajectory | None = None
             state: FootstepState | None = None
+            stretch = 1.0
             for attempt, (use_shortcut, scale) in enumerate(plans, start=1):
-                timing = prepared.timings[k].scaled(scale)
+                timing = prepared.timings[k].scaled(scale * stretch)
                 if timing.shift_s + timing.swing_s > cfg.timing.max_step_s and attempt > 1:
                     break
-                state = self.initial_state(prepared, k, start, use_shortcut, scale)
+                state, stretch = self._retimed(prepared, k, start, use_shortcut, scale, stretch)
                 initial = capsule_clearances(
                     self.wb, self.sdf, state.q, state.body[:, :3], state.rotation
                 )

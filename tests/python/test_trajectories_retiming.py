@@ -1,0 +1,108 @@
+"""Steps whose swing outruns a joint's velocity limit are lengthened before CHOMP.
+
+The nominal timing (§5.2) is made deliberately too short here; the generator
+must measure the initial trajectory's swing speed as the control-rate check
+does, stretch the step by the excess, and hand on a step within the limits at
+its first attempt (the restart of §5.3 came only after CHOMP's whole budget).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from _trajectory_plans import BARRIER, barrier_step_plan
+
+import roughwalk as rw
+from roughwalk.trajectories import straight_crawl_plan
+from roughwalk.trajectories.footstep_trajectory import (
+    resample_footstep,
+    swing_leg_angles,
+    swing_speed_ratio,
+)
+from roughwalk.trajectories.generator import RETIME_MARGIN, FootstepTrajectoryGenerator
+
+
+@pytest.fixture(scope="module")
+def robot() -> rw.Robot:
+    return rw.load_robot("littledog")
+
+
+@pytest.fixture(scope="module")
+def crawl(robot: rw.Robot):
+    terrain = rw.load_terrain("flat:length=1.2,width=0.5")
+    gen = FootstepTrajectoryGenerator(robot, terrain)
+    plan = straight_crawl_plan(robot, terrain, (0.3, 0.0), steps=4, stride=0.07)
+    return gen, gen.prepare(plan)
+
+
+def _hurried(prepared, factor: float):
+    """The same plan with every step's nominal timing shortened by ``factor``."""
+    return dataclasses.replace(
+        prepared, timings=[t.scaled(factor).quantized(0.02) for t in prepared.timings]
+    )
+
+
+def _swing_leg_speed(traj, robot: rw.Robot, leg: int, limit: np.ndarray) -> np.ndarray:
+    """|q̇| / limit (n, 3) of the swing leg in a produced trajectory."""
+    qd = robot.to_canonical(traj.qd).reshape(-1, 4, 3)[:, leg]
+    return np.abs(qd) / limit
+
+
+def test_swing_speed_ratio_predicts_the_control_rate_check(crawl, robot: rw.Robot) -> None:
+    """The ratio is what resample_footstep's q̇ shows on the airborne swing leg."""
+    gen, prepared = crawl
+    cfg = gen.config
+    for factor in (1.0, 0.6):
+        state = gen.initial_state(_hurried(prepared, factor), 1, prepared.start)
+        ratio = swing_speed_ratio(state, gen.wb, cfg.control_rate_hz)
+        traj = resample_footstep(
+            state,
+            gen.wb,
+            gen.sdf,
+            cfg,
+            optimize_ms=0.0,
+            attempts=1,
+            iterations=0,
+            initial_min_clearance=0.0,
+        )
+        leg = state.step.leg
+        airborne = ~traj.support[:, leg]
+        # The produced swing leg is exactly the spline the ratio differentiates.
+        q = robot.to_canonical(traj.q).reshape(-1, 4, 3)[airborne, leg]
+        np.testing.assert_allclose(q, swing_leg_angles(state, gen.wb, traj.time[airborne]))
+        speed = _swing_leg_speed(traj, robot, leg, gen.wb.velocity_limit[leg])[airborne]
+        # Away from lift-off and touchdown the differences are the same ones.
+        assert np.max(speed[1:-1]) <= ratio + 1e-12
+        assert ratio == pytest.approx(np.max(speed), rel=0.05)
+
+
+def test_a_hurried_swing_is_lengthened_before_chomp(crawl, robot: rw.Robot) -> None:
+    """Timings 40 % too short: every step is stretched at once and keeps the limits."""
+    gen, prepared = crawl
+    hurried = _hurried(prepared, 0.6)
+    rate = gen.config.control_rate_hz
+    ratio = swing_speed_ratio(gen.initial_state(hurried, 0, prepared.start), gen.wb, rate)
+    assert ratio > 1.05, "the test needs a first step that breaks the limit"
+    for k, traj in enumerate(gen.iter_steps(hurried)):
+        r = traj.report
+        assert r.velocity_limits_ok, f"step {k + 1}: {r.notes}"
+        assert r.attempts == 1, f"step {k + 1} restarted: {r.notes}"
+        assert traj.report.duration_s >= hurried.timings[k].duration_s - 1e-9
+    first = next(iter(gen.iter_steps(hurried)))
+    nominal = hurried.timings[0]
+    # Stretched by about the excess (times the margin), not by a whole restart factor.
+    stretch = (first.report.shift_s + first.report.swing_s) / (nominal.shift_s + nominal.swing_s)
+    assert 1.0 < stretch <= ratio * RETIME_MARGIN * 1.1 + 0.05
+
+
+def test_steps_within_the_limits_are_not_stretched(robot: rw.Robot) -> None:
+    """The barrier step at its nominal timing already keeps the limits: its duration stays."""
+    terrain = rw.load_terrain(BARRIER)
+    gen = FootstepTrajectoryGenerator(robot, terrain)
+    prepared = gen.prepare(barrier_step_plan(robot, terrain, gen.wb))
+    state = gen.initial_state(prepared, 0, prepared.start)
+    assert swing_speed_ratio(state, gen.wb, gen.config.control_rate_hz) <= 1.0
+    traj = next(iter(gen.iter_steps(prepared)))
+    assert traj.report.duration_s == pytest.approx(prepared.timings[0].duration_s)
