@@ -106,3 +106,38 @@ def test_steps_within_the_limits_are_not_stretched(robot: rw.Robot) -> None:
     assert swing_speed_ratio(state, gen.wb, gen.config.control_rate_hz) <= 1.0
     traj = next(iter(gen.iter_steps(prepared)))
     assert traj.report.duration_s == pytest.approx(prepared.timings[0].duration_s)
+
+
+def test_a_velocity_jump_is_not_restarted(crawl, robot: rw.Robot) -> None:
+    """A joint 'speed' no lengthening can bring under its limit is handed on, not restarted.
+
+    Such jumps come from IK switching branch where a supporting foot is lost
+    (the LittleDog AD crawl fall-back's first step: 100–250 rad/s); a mild
+    excess is still worth the longer step of §5.3.
+    """
+    gen, prepared = crawl
+    traj = next(iter(gen.iter_steps(prepared)))
+    limit = robot.from_canonical(gen.wb.velocity_limit.reshape(12))
+
+    def breaking(factor: float):
+        qd = traj.qd.copy()
+        qd[len(qd) // 2, 4] = factor * limit[4]
+        report = dataclasses.replace(
+            traj.report,
+            valid=False,
+            velocity_limits_ok=False,
+            velocity_margin_rad_s=float(np.min(limit - np.abs(qd))),
+            chomp_status="converged",
+            used_shortcut=False,
+        )
+        return dataclasses.replace(traj, qd=qd, report=report)
+
+    longest = 1.3**2
+    assert gen._worth_restarting(breaking(1.1), None, False, longest)
+    assert not gen._worth_restarting(breaking(20.0), None, False, longest)
+    # A collision is still worth a longer step whatever the speeds.
+    colliding = breaking(20.0)
+    colliding = dataclasses.replace(
+        colliding, report=dataclasses.replace(colliding.report, collision_free=False)
+    )
+    assert gen._worth_restarting(colliding, None, False, longest)

@@ -434,9 +434,12 @@ class FootstepTrajectoryGenerator:
             state = self.initial_state(prepared, k, start, use_shortcut, scale * stretch)
         return state, stretch
 
-    @staticmethod
     def _worth_restarting(
-        result: FootstepTrajectory, previous: FootstepTrajectory | None, was_shortcut: bool
+        self,
+        result: FootstepTrajectory,
+        previous: FootstepTrajectory | None,
+        was_shortcut: bool,
+        longest_stretch: float,
     ) -> bool:
         """Whether another attempt may help (§5.3 restarts on collisions and velocity limits).
 
@@ -444,7 +447,11 @@ class FootstepTrajectoryGenerator:
         tried only while the last one collided or broke a velocity limit, and
         made progress on that over the attempt before (clearance up by 0.5 mm
         or the velocity margin up), so hopeless steps are handed on early;
-        never when the samples CHOMP cannot move were at fault.
+        never when the samples CHOMP cannot move were at fault, nor for a
+        joint speed more than ``longest_stretch`` (what the remaining restarts
+        can lengthen the step by) times its limit: that is a jump (an IK
+        branch switching where a supporting foot is lost), not a speed, and
+        no duration brings it under the limit.
         """
         r = result.report
         if was_shortcut:
@@ -453,6 +460,11 @@ class FootstepTrajectoryGenerator:
             return False
         if r.collision_free and r.velocity_limits_ok:
             return False
+        if r.collision_free:
+            qd = self.robot.to_canonical(result.qd).reshape(-1, 12)
+            peak = float(np.max(np.abs(qd) / self.wb.velocity_limit.reshape(12)))
+            if peak > longest_stretch:
+                return False
         if previous is None or previous.report.used_shortcut:
             return True
         p = previous.report
@@ -512,7 +524,14 @@ class FootstepTrajectoryGenerator:
                     initial_min_clearance=initial_min,
                     chomp_status=outcome.status.value,
                 )
-                if result.valid or not self._worth_restarting(result, previous, use_shortcut):
+                later = [s for _, s in plans[attempt:]]
+                longest = min(
+                    max(later, default=scale) / scale,
+                    cfg.timing.max_step_s / (timing.shift_s + timing.swing_s),
+                )
+                if result.valid or not self._worth_restarting(
+                    result, previous, use_shortcut, longest
+                ):
                     break
                 previous = result
             assert result is not None and state is not None
