@@ -273,13 +273,18 @@ class FootstepTrajectoryGenerator:
             budget = min(cfg.swing_iterations, cfg.max_iterations - total)
             if budget <= 0:
                 break
+            rest_feasible = body.feasible_without_leg(state.step.leg)
+            # The swing pass stops once its leg is feasible even where the rest
+            # is not: it cannot repair the trunk or the stance legs, and running
+            # out its budget there (a supporting foot lost on the LittleDog AD
+            # crawl fall-back) only delayed the next trunk pass.
             swing = SwingPass(
                 self.wb,
                 state,
                 self.sdf,
                 cfg,
                 validity,
-                rest_feasible=body.feasible_without_leg(state.step.leg),
+                rest_feasible=True,
                 reference=swing_reference,
                 backend=self.backend,
             )
@@ -294,7 +299,7 @@ class FootstepTrajectoryGenerator:
             res2 = chomp.optimize(swing.initial, budget)
             total += res2.iterations
             swing.apply(res2.xi)
-            if res2.status == ChompStatus.VALID:
+            if res2.status == ChompStatus.VALID and rest_feasible:
                 return OptimizationOutcome(total, ChompStatus.VALID)
             if res.iterations == 0 and res2.iterations == 0:
                 status = ChompStatus.CONVERGED

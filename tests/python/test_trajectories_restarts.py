@@ -1,9 +1,10 @@
-"""Steps whose swing outruns a joint's velocity limit are lengthened before CHOMP.
+"""Work the generator no longer wastes: restarts and iterations that cannot help.
 
-The nominal timing (§5.2) is made deliberately too short here; the generator
-must measure the initial trajectory's swing speed as the control-rate check
-does, stretch the step by the excess, and hand on a step within the limits at
-its first attempt (the restart of §5.3 came only after CHOMP's whole budget).
+A swing that outruns a joint's velocity limit is lengthened before CHOMP by
+the measured excess (the nominal timing is made deliberately too short here;
+the restart of §5.3 came only after CHOMP's whole budget); a velocity "jump"
+that no longer step can fix is not restarted; and the swing pass hands back
+to the trunk pass once its own leg is feasible.
 """
 
 from __future__ import annotations
@@ -141,3 +142,40 @@ def test_a_velocity_jump_is_not_restarted(crawl, robot: rw.Robot) -> None:
         colliding, report=dataclasses.replace(colliding.report, collision_free=False)
     )
     assert gen._worth_restarting(colliding, None, False, longest)
+
+
+def test_the_swing_pass_stops_when_its_leg_is_clear_though_the_rest_is_not(
+    robot: rw.Robot,
+) -> None:
+    """Coordinate descent hands back to the trunk once the swing leg is done.
+
+    The Figure-8 barrier step with a supporting foot moved out of reach at the
+    last sample (which CHOMP cannot move): the step can never be valid. The
+    swing pass must still clear the barrier, then stop, instead of running
+    out the whole iteration budget on a leg that is already feasible.
+    """
+    from _trajectory_plans import low_swing_config
+
+    from roughwalk.trajectories.chomp import ChompStatus
+    from roughwalk.trajectories.step_report import capsule_clearances
+
+    terrain = rw.load_terrain(BARRIER)
+    cfg = rw.trajectories.trajectory_config(**low_swing_config())
+    gen = FootstepTrajectoryGenerator(robot, terrain, config=cfg)
+    prepared = gen.prepare(barrier_step_plan(robot, terrain, gen.wb))
+    state = gen.initial_state(prepared, 0, prepared.start)
+    leg = state.step.leg
+    other = (leg + 1) % 4
+    state.feet[-1, other, 2] -= 0.1
+    state.solve_legs(gen.wb)
+    assert not state.reached[-1, other]
+    swing_links = (gen.wb.collision.leg == leg) & ~gen.wb.collision.is_foot
+    before = capsule_clearances(gen.wb, gen.sdf, state.q, state.body[:, :3], state.rotation)
+    assert before[:, swing_links].min() < 0, "the blind swing must hit the barrier"
+
+    outcome = gen.optimize(state)
+
+    assert outcome.status != ChompStatus.VALID
+    after = capsule_clearances(gen.wb, gen.sdf, state.q, state.body[:, :3], state.rotation)
+    assert after[:, swing_links].min() >= cfg.validity.min_clearance - 1e-9
+    assert outcome.iterations < cfg.chomp.max_iterations
