@@ -2,10 +2,12 @@
 
 For each footstep: estimate its timing from the joint velocity limits, build
 the initial trajectory (ZMP preview over a window of the next footsteps,
-certificate splines, swing spline, IK), run CHOMP as coordinate descent
-(trunk, then swing leg) until the trajectory is valid or the iterations run
-out, check it at the control rate, and if it still collides or breaks a
-velocity limit, lengthen the step, regenerate and restart. The first attempt
+certificate splines, swing spline, IK) and, where its swing already outruns
+a joint's velocity limit, lengthen it by that excess at once; run CHOMP as
+coordinate descent (trunk, then swing leg) until the trajectory is valid or
+the iterations run out, check it at the control rate, and if it still
+collides or breaks a velocity limit, lengthen the step, regenerate and
+restart. The first attempt
 uses the shortcut ZMP (footnote 2) where it is safe, and the restarts fall
 back to the certificate. A step that stays infeasible is marked and handed on
 ("in our system we chose instead to optimistically execute these
