@@ -403,6 +403,20 @@ def center_of_mass_batch(
 ) -> NDArray[np.float64]:
     """Whole-robot CoM (N, 3) in the base frame [m] for joint angles (N, 4, 3) [rad]."""
 
+def reach_by_height_and_tilt(
+    quadruped: Quadruped,
+    hips: ArrayLike,
+    feet: ArrayLike,
+    base_pos: ArrayLike,
+    rotation: ArrayLike,
+    iterations: int,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """Trunk position (3,) [m] and orientation (3, 3) lowered and tilted until feet (4, 3) reach.
+
+    ``hips`` (4, 3) are the hip anchors in the base frame [m]; None when every
+    foot is reached from the start (Zucker 2011, §3.2 without the horizontal part).
+    """
+
 def capsule_clearances(
     quadruped: Quadruped,
     sdf: SdfField,

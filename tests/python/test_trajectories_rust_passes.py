@@ -177,3 +177,40 @@ def test_capsule_clearances_equal_the_numpy_reference(barrier) -> None:
     assert rust.shape == numpy.shape == (state.n_samples, len(gen.wb.collision))
     assert numpy.min() < 0.01  # the barrier is near
     np.testing.assert_allclose(rust, numpy, rtol=0, atol=1e-12)
+
+
+def test_reach_by_height_and_tilt_equals_the_numpy_reference(crawl) -> None:
+    """The Rust trunk adjustment for reach equals the numpy loop it replaced.
+
+    From the crawl's touchdown stance, the trunk is raised, shifted and tilted
+    at random, so that feet are lost and found again over the 30 rounds (or
+    stay lost, where the loop runs to its end); both must agree on whether
+    anything changed and on the pose to 1e-9.
+    """
+    from roughwalk.trajectories.initial_trajectory import (
+        _reach_by_height_and_tilt,
+        reach_by_height_and_tilt_reference,
+    )
+
+    gen, state = crawl
+    feet = state.step.stance_after
+    base = state.body[state.touchdown]
+    rng = np.random.default_rng(7)
+    outcomes = {"unchanged": 0, "reached": 0, "still out of reach": 0}
+    for _ in range(40):
+        pose = base + np.concatenate(
+            [rng.uniform(-0.03, 0.03, 2), rng.uniform(-0.02, 0.07, 1), rng.uniform(-0.3, 0.3, 3)]
+        )
+        for iterations in (1, 30):
+            rust = _reach_by_height_and_tilt(gen.wb, feet, pose, iterations)
+            numpy = reach_by_height_and_tilt_reference(gen.wb, feet, pose, iterations)
+            assert (rust is None) == (numpy is None)
+            if rust is None or numpy is None:
+                outcomes["unchanged"] += 1
+                continue
+            np.testing.assert_allclose(rust, numpy, rtol=0, atol=1e-9)
+            rot = rw.trajectories.euler.rpy_to_matrix(rust[3:])
+            _, reached = gen.wb.inverse_kinematics(((feet - rust[:3]) @ rot)[None])
+            outcomes["reached" if reached.all() else "still out of reach"] += 1
+    # The random poses cover all three outcomes.
+    assert min(outcomes.values()) > 0, outcomes

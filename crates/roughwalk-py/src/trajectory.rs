@@ -9,8 +9,8 @@ use roughwalk_core::kinematics::math::{Mat3, Vec3};
 use roughwalk_core::trajectory::body_pass::BodyPassSetup;
 use roughwalk_core::trajectory::swing_pass::SwingPassSetup;
 use roughwalk_core::trajectory::{
-    capsule_clearances, center_of_mass_batch, BodyPass, BodyPoints, GradientMode, LinkCapsules,
-    MassDistribution, ObstacleTerm, SwingPass, ZmpSupport,
+    capsule_clearances, center_of_mass_batch, reach_by_height_and_tilt, BodyPass, BodyPoints,
+    GradientMode, LinkCapsules, MassDistribution, ObstacleTerm, SwingPass, ZmpSupport,
 };
 use roughwalk_core::CoreError;
 
@@ -423,11 +423,51 @@ fn capsule_clearances_py<'py>(
     array(py, d, &[n, p])
 }
 
+/// The trunk's position (3,) [m] and orientation (3, 3) moved by height and tilt
+/// until the feet (4, 3) [m, world] are reached (hips (4, 3): the hip anchors in
+/// the base frame [m]); None when they all are from the start.
+#[pyfunction]
+#[pyo3(name = "reach_by_height_and_tilt")]
+fn reach_by_height_and_tilt_py<'py>(
+    py: Python<'py>,
+    quadruped: PyRef<'py, PyQuadruped>,
+    hips: ArrayIn<'py>,
+    feet: ArrayIn<'py>,
+    base_pos: ArrayIn<'py>,
+    rotation: ArrayIn<'py>,
+    iterations: usize,
+) -> PyResult<Option<(Bound<'py, PyAny>, Bound<'py, PyAny>)>> {
+    let hips = vec3_rows(&read(&hips, "hips", &[Some(4), Some(3)])?);
+    let feet = vec3_rows(&read(&feet, "feet", &[Some(4), Some(3)])?);
+    let x = read(&base_pos, "base_pos", &[Some(3)])?;
+    let r = read(&rotation, "rotation", &[Some(3), Some(3)])?;
+    let hips: [Vec3; 4] = std::array::from_fn(|l| hips[l]);
+    let feet: [Vec3; 4] = std::array::from_fn(|l| feet[l]);
+    let rot: Mat3 = [[r[0], r[1], r[2]], [r[3], r[4], r[5]], [r[6], r[7], r[8]]];
+    let moved = reach_by_height_and_tilt(
+        &quadruped.inner,
+        &hips,
+        &feet,
+        [x[0], x[1], x[2]],
+        rot,
+        iterations,
+    );
+    moved
+        .map(|(x, rot)| {
+            Ok((
+                array(py, x.to_vec(), &[3])?,
+                array(py, rot.concat(), &[3, 3])?,
+            ))
+        })
+        .transpose()
+}
+
 /// Adds the pass evaluators and the CoM and clearance batches to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(capsule_clearances_py, m)?)?;
     m.add_class::<PyBodyPassEvaluator>()?;
     m.add_class::<PySwingPassEvaluator>()?;
     m.add_function(wrap_pyfunction!(center_of_mass_batch_py, m)?)?;
+    m.add_function(wrap_pyfunction!(reach_by_height_and_tilt_py, m)?)?;
     Ok(())
 }

@@ -190,7 +190,7 @@ class BodyPass:
         self.active = ~foot_down
         self.held_q = state.q.copy()
         self.footholds = np.array([state.step.start, state.step.target])
-        self.hips = wb.robot.hip_positions
+        self.hips = wb.hips
         self.backend = resolve_backend(backend, obstacle.sdf)
         self._rust: _core.BodyPassEvaluator | None = None
         field = compiled_field(obstacle.sdf)

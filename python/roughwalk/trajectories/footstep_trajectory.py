@@ -27,7 +27,13 @@ from roughwalk.trajectories.step_report import StepReport, capsule_clearances, c
 from roughwalk.trajectories.support_polygon import polygon_margin
 from roughwalk.trajectories.whole_body import WholeBody
 
-__all__ = ["FootstepTrajectory", "resample_footstep"]
+__all__ = [
+    "FootstepTrajectory",
+    "control_times",
+    "resample_footstep",
+    "swing_leg_angles",
+    "swing_speed_ratio",
+]
 
 
 @dataclass(frozen=True)
@@ -110,6 +116,44 @@ class FootstepTrajectory:
         return {k: getattr(self, k) for k in names}
 
 
+def control_times(state: FootstepState, rate_hz: float) -> tuple[NDArray[np.float64], float]:
+    """The control-rate sample times [s] of a footstep (both ends included) and their period."""
+    t0, t1 = float(state.times[0]), float(state.times[-1])
+    n = max(int(round((t1 - t0) * rate_hz)), 1)
+    return np.linspace(t0, t1, n + 1), (t1 - t0) / n
+
+
+def swing_leg_angles(
+    state: FootstepState, wb: WholeBody, time: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """The swing leg's angles (len(time), 3) [rad]: a cubic through its CHOMP samples.
+
+    Clamped to the joint limits; ``time`` [s] should lie between lift-off and touchdown.
+    """
+    leg = state.step.leg
+    window = slice(state.lift_off, state.touchdown + 1)
+    swing_times = state.times[window]
+    spline = make_interp_spline(swing_times, state.q[window, leg], k=min(3, len(swing_times) - 1))
+    return np.clip(spline(time), wb.lower[leg], wb.upper[leg])
+
+
+def swing_speed_ratio(state: FootstepState, wb: WholeBody, rate_hz: float) -> float:
+    """Peak over the swing leg's joints of |q̇| / velocity limit while it is airborne.
+
+    q̇ as :func:`resample_footstep` computes it (second-order differences at
+    the control rate ``rate_hz`` [Hz] of :func:`swing_leg_angles`), so a value
+    above 1 predicts that its velocity check will fail on the swing leg.
+    """
+    time, dt = control_times(state, rate_hz)
+    t_lift, t_touch = state.times[state.lift_off], state.times[state.touchdown]
+    airborne = (time > t_lift + 1e-9) & (time < t_touch - 1e-9)
+    if airborne.sum() < 3:
+        return 0.0
+    q = swing_leg_angles(state, wb, time[airborne])
+    qd = np.gradient(q, dt, axis=0, edge_order=2)
+    return float(np.max(np.abs(qd) / wb.velocity_limit[state.step.leg]))
+
+
 def resample_footstep(
     state: FootstepState,
     wb: WholeBody,
@@ -124,10 +168,8 @@ def resample_footstep(
 ) -> FootstepTrajectory:
     """Sample ``state`` at the control rate, check it, and package it."""
     robot = wb.robot
-    t0, t1 = float(state.times[0]), float(state.times[-1])
-    n = max(int(round((t1 - t0) * config.control_rate_hz)), 1)
-    time = np.linspace(t0, t1, n + 1)
-    dt = (t1 - t0) / n
+    time, dt = control_times(state, config.control_rate_hz)
+    n = len(time) - 1
     # A quintic clamped at both ends to the rates and accelerations the step
     # starts and ends with, so consecutive footsteps join with continuous trunk
     # velocity and acceleration (and the ZMP computed from it stays put there).
@@ -164,10 +206,7 @@ def resample_footstep(
     # The lifted leg's angles come from its own spline below.
     feet_b[airborne, leg] = wb.nominal_feet[leg]
     q, reached = wb.inverse_kinematics(feet_b)
-    window = slice(state.lift_off, state.touchdown + 1)
-    swing_times = state.times[window]
-    swing_q = make_interp_spline(swing_times, state.q[window, leg], k=min(3, len(swing_times) - 1))
-    q[airborne, leg] = np.clip(swing_q(time[airborne]), wb.lower[leg], wb.upper[leg])
+    q[airborne, leg] = swing_leg_angles(state, wb, time[airborne])
     feet_fk = body[:, None, :3] + np.einsum("tij,tlj->tli", rot, wb.foot_positions(q))
     feet[airborne, leg] = feet_fk[airborne, leg]
     qd = np.gradient(q, dt, axis=0, edge_order=2)

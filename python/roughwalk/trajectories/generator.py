@@ -2,10 +2,12 @@
 
 For each footstep: estimate its timing from the joint velocity limits, build
 the initial trajectory (ZMP preview over a window of the next footsteps,
-certificate splines, swing spline, IK), run CHOMP as coordinate descent
-(trunk, then swing leg) until the trajectory is valid or the iterations run
-out, check it at the control rate, and if it still collides or breaks a
-velocity limit, lengthen the step, regenerate and restart. The first attempt
+certificate splines, swing spline, IK) and, where its swing already outruns
+a joint's velocity limit, lengthen it by that excess at once; run CHOMP as
+coordinate descent (trunk, then swing leg) until the trajectory is valid or
+the iterations run out, check it at the control rate, and if it still
+collides or breaks a velocity limit, lengthen the step, regenerate and
+restart. The first attempt
 uses the shortcut ZMP (footnote 2) where it is safe, and the restarts fall
 back to the certificate. A step that stays infeasible is marked and handed on
 ("in our system we chose instead to optimistically execute these
@@ -28,7 +30,11 @@ from roughwalk.trajectories.body_pass import BACKENDS, BodyPass
 from roughwalk.trajectories.chomp import Chomp, ChompStatus
 from roughwalk.trajectories.config import TrajectoryConfig
 from roughwalk.trajectories.costs.obstacle import ObstacleCost
-from roughwalk.trajectories.footstep_trajectory import FootstepTrajectory, resample_footstep
+from roughwalk.trajectories.footstep_trajectory import (
+    FootstepTrajectory,
+    resample_footstep,
+    swing_speed_ratio,
+)
 from roughwalk.trajectories.initial_trajectory import (
     FootstepState,
     StartState,
@@ -57,6 +63,15 @@ EXIT_MARGIN_FACTOR = 2.0
 """Where each swing leaves the ZMP, in multiples of the support term's margin inside
 its triangle: the preview controller lags its reference, and the ZMP must still be
 inside when the foot lands."""
+
+
+RETIME_MARGIN = 1.02
+"""A swing whose initial trajectory breaks a velocity limit by the factor r is
+lengthened by r times this before CHOMP: the trunk's preview motion does not
+scale exactly with the step's duration."""
+
+RETIME_LIMIT = 3
+"""Most re-timings of one initial trajectory before CHOMP is run on it anyway."""
 
 
 @dataclass(frozen=True)
@@ -260,13 +275,18 @@ class FootstepTrajectoryGenerator:
             budget = min(cfg.swing_iterations, cfg.max_iterations - total)
             if budget <= 0:
                 break
+            rest_feasible = body.feasible_without_leg(state.step.leg)
+            # The swing pass stops once its leg is feasible even where the rest
+            # is not: it cannot repair the trunk or the stance legs, and running
+            # out its budget there (a supporting foot lost on the LittleDog AD
+            # crawl fall-back) only delayed the next trunk pass.
             swing = SwingPass(
                 self.wb,
                 state,
                 self.sdf,
                 cfg,
                 validity,
-                rest_feasible=body.feasible_without_leg(state.step.leg),
+                rest_feasible=True,
                 reference=swing_reference,
                 backend=self.backend,
             )
@@ -281,7 +301,7 @@ class FootstepTrajectoryGenerator:
             res2 = chomp.optimize(swing.initial, budget)
             total += res2.iterations
             swing.apply(res2.xi)
-            if res2.status == ChompStatus.VALID:
+            if res2.status == ChompStatus.VALID and rest_feasible:
                 return OptimizationOutcome(total, ChompStatus.VALID)
             if res.iterations == 0 and res2.iterations == 0:
                 status = ChompStatus.CONVERGED
@@ -387,9 +407,46 @@ class FootstepTrajectoryGenerator:
         state.contact_clearance = min(float(np.min(d)), 0.0)
         return state
 
-    @staticmethod
+    def _retimed(
+        self,
+        prepared: PreparedPlan,
+        k: int,
+        start: StartState,
+        use_shortcut: bool,
+        scale: float,
+        stretch: float,
+    ) -> tuple[FootstepState, float]:
+        """The initial trajectory of step k, lengthened until its swing keeps the velocity limits.
+
+        The nominal timing (§5.2) sees the swing leg under a still trunk; the
+        preview controller moves the trunk during the swing, and the swing leg
+        can then outrun a joint's limit by up to ~20 % (LittleDog boards A, C,
+        Y). CHOMP's joint-speed term rarely recovers that, and the restart
+        (§5.3) came only after its whole iteration budget, twice. Measuring the
+        swing's peak joint speed on the initial trajectory and stretching the
+        step by the excess costs one more initial trajectory instead.
+        Returns the state and the stretch factor (≥ 1) later attempts keep.
+        """
+        cfg = self.config
+        state = self.initial_state(prepared, k, start, use_shortcut, scale * stretch)
+        for _ in range(RETIME_LIMIT):
+            ratio = swing_speed_ratio(state, self.wb, cfg.control_rate_hz)
+            if ratio <= 1.0:
+                break
+            longer = stretch * ratio * RETIME_MARGIN
+            timing = prepared.timings[k].scaled(scale * longer)
+            if timing.shift_s + timing.swing_s > cfg.timing.max_step_s:
+                break
+            stretch = longer
+            state = self.initial_state(prepared, k, start, use_shortcut, scale * stretch)
+        return state, stretch
+
     def _worth_restarting(
-        result: FootstepTrajectory, previous: FootstepTrajectory | None, was_shortcut: bool
+        self,
+        result: FootstepTrajectory,
+        previous: FootstepTrajectory | None,
+        was_shortcut: bool,
+        longest_stretch: float,
     ) -> bool:
         """Whether another attempt may help (§5.3 restarts on collisions and velocity limits).
 
@@ -397,7 +454,11 @@ class FootstepTrajectoryGenerator:
         tried only while the last one collided or broke a velocity limit, and
         made progress on that over the attempt before (clearance up by 0.5 mm
         or the velocity margin up), so hopeless steps are handed on early;
-        never when the samples CHOMP cannot move were at fault.
+        never when the samples CHOMP cannot move were at fault, nor for a
+        joint speed more than ``longest_stretch`` (what the remaining restarts
+        can lengthen the step by) times its limit: that is a jump (an IK
+        branch switching where a supporting foot is lost), not a speed, and
+        no duration brings it under the limit.
         """
         r = result.report
         if was_shortcut:
@@ -406,6 +467,11 @@ class FootstepTrajectoryGenerator:
             return False
         if r.collision_free and r.velocity_limits_ok:
             return False
+        if r.collision_free:
+            qd = self.robot.to_canonical(result.qd).reshape(-1, 12)
+            peak = float(np.max(np.abs(qd) / self.wb.velocity_limit.reshape(12)))
+            if peak > longest_stretch:
+                return False
         if previous is None or previous.report.used_shortcut:
             return True
         p = previous.report
@@ -434,11 +500,12 @@ class FootstepTrajectoryGenerator:
             result: FootstepTrajectory | None = None
             previous: FootstepTrajectory | None = None
             state: FootstepState | None = None
+            stretch = 1.0
             for attempt, (use_shortcut, scale) in enumerate(plans, start=1):
-                timing = prepared.timings[k].scaled(scale)
+                timing = prepared.timings[k].scaled(scale * stretch)
                 if timing.shift_s + timing.swing_s > cfg.timing.max_step_s and attempt > 1:
                     break
-                state = self.initial_state(prepared, k, start, use_shortcut, scale)
+                state, stretch = self._retimed(prepared, k, start, use_shortcut, scale, stretch)
                 initial = capsule_clearances(
                     self.wb, self.sdf, state.q, state.body[:, :3], state.rotation
                 )
@@ -464,7 +531,14 @@ class FootstepTrajectoryGenerator:
                     initial_min_clearance=initial_min,
                     chomp_status=outcome.status.value,
                 )
-                if result.valid or not self._worth_restarting(result, previous, use_shortcut):
+                later = [s for _, s in plans[attempt:]]
+                longest = min(
+                    max(later, default=scale) / scale,
+                    cfg.timing.max_step_s / (timing.shift_s + timing.swing_s),
+                )
+                if result.valid or not self._worth_restarting(
+                    result, previous, use_shortcut, longest
+                ):
                     break
                 previous = result
             assert result is not None and state is not None

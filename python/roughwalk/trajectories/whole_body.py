@@ -150,9 +150,10 @@ class WholeBody:
         lo = np.where(np.isfinite(self.lower), self.lower, -np.pi)
         hi = np.where(np.isfinite(self.upper), self.upper, np.pi)
         samples = lo[None] + grid[:, None, :] * (hi - lo)[None]
-        hips = np.asarray(robot.hip_positions)
+        self.hips = np.asarray(robot.hip_positions, dtype=float)
+        """(4, 3) the legs' hip (HAA) anchors in the base frame [m]."""
         feet = self.foot_positions(samples, self.link_frames(samples))
-        self.max_reach = np.linalg.norm(feet - hips[None], axis=-1).max(axis=0)
+        self.max_reach = np.linalg.norm(feet - self.hips[None], axis=-1).max(axis=0)
         """(4,) the farthest each foot gets from its hip (HAA anchor) [m]."""
         self.nominal_feet = np.asarray(robot.nominal_stance.feet, dtype=float)
         """(4, 3) feet in the base frame at the nominal joint angles [m]: an IK
