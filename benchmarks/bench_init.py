@@ -17,6 +17,17 @@ median solve ≤ 0.25 s on one core, ≥ 4× fewer iterations than the
 Heuristic (medians), ≤ 1 % of held-out tasks beyond g_max (the threshold
 training used, set from the Heuristic's costs) or infeasible.
 
+The figure's solve times are wall times of whatever ran them. On a shared
+machine the medians that count are CPU times: ``--timing-tasks`` held-out
+tasks are solved again back to back in this process from every
+initialiser, timing each solve's process CPU time and wall time (the
+initial guess included, the NLP's build not).
+
+Beyond g_max counts tasks whose cost is above one threshold for all tasks;
+where the task space's costs differ by task (far starts cost more on the
+single pallet), "worse than the best" counts, per task, the initialisers
+whose cost is more than 2 % above the best any of them reached on it.
+
 Run: ``roughwalk bench init [--env single_pallet] [--models DIR] [--tasks N]``.
 Writes ``benchmarks/results/init_ENV.json`` and ``init_ENV.png``.
 """
@@ -64,10 +75,14 @@ def _models(folder: Path | None, env: str) -> list[tuple[str, LearnedModel]]:
     return out
 
 
-def _summary(data: Dataset, g_max: float, limit: int) -> dict[str, Any]:
+WORSE_THAN_BEST = 1.02  # a cost more than 2 % above the task's best counts as a worse minimum
+
+
+def _summary(data: Dataset, g_max: float, limit: int, best: np.ndarray) -> dict[str, Any]:
     solved = np.isin(data["status"], ("exact", "approximate"))
     feasible = feasible_mask(data)
     beyond = ~feasible | (data["cost"] > g_max)
+    worse = ~feasible | (data["cost"] > WORSE_THAN_BEST * best)
     its = data["iterations"]
     curve = [float(np.mean(solved & (its <= k))) for k in range(limit + 1)]
     times = data["solve_time_s"][solved]
@@ -77,6 +92,7 @@ def _summary(data: Dataset, g_max: float, limit: int) -> dict[str, Any]:
         "median_iterations": float(np.median(its[solved])) if solved.any() else float("nan"),
         "median_solve_s": float(np.median(times)) if times.size else float("nan"),
         "beyond_g_max": float(beyond.mean()),
+        "worse_than_best": float(worse.mean()),
         "median_cost": float(np.median(data["cost"][feasible])) if feasible.any() else None,
         "converged_by_iteration": curve,
         "costs": [float(c) for c in data["cost"]],
@@ -113,10 +129,48 @@ def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:
         from roughwalk.learning import cost_threshold
 
         g_max = cost_threshold(runs["Heuristic"]["cost"][feasible_mask(runs["Heuristic"])])
+    costs = np.stack([np.where(feasible_mask(v), v["cost"], np.inf) for v in runs.values()])
+    best = costs.min(axis=0)
     return {
         "g_max": g_max,
-        "initializers": {k: _summary(v, g_max, args.max_iter) for k, v in runs.items()},
+        "initializers": {k: _summary(v, g_max, args.max_iter, best) for k, v in runs.items()},
     }
+
+
+def timing(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, dict[str, float]]:
+    """Median CPU and wall time [s] per solve, back to back in this process, per initialiser."""
+    from roughwalk.learning.initializer import LearnedInitializer
+
+    space = task_space(args.env)
+    tasks = space.sample(args.timing_tasks, split="test")
+    problem = build_problem(spec)
+    initializers: dict[str, Any] = {"Heuristic": HeuristicInitializer}
+    for name, model in _models(args.models, args.env):
+        initializers[name] = lambda model=model: _with_model(LearnedInitializer(), model)
+    out = {}
+    for name, make in initializers.items():
+        # One untimed solve builds what is built on first use (IPOPT's warm-start solver).
+        problem.solve(tasks[0], make(), max_iter=args.max_iter)
+        cpu, wall, its = [], [], []
+        for task in tasks:
+            c0, w0 = time.process_time(), time.perf_counter()
+            result = problem.solve(task, make(), max_iter=args.max_iter)
+            cpu.append(time.process_time() - c0)
+            wall.append(time.perf_counter() - w0)
+            its.append(result.iterations)
+        out[name] = {
+            "tasks": len(tasks),
+            "median_cpu_s": statistics.median(cpu),
+            "median_wall_s": statistics.median(wall),
+            "median_iterations": statistics.median(its),
+            "cpu_per_iteration_ms": 1000 * sum(cpu) / max(sum(its), 1),
+        }
+    return out
+
+
+def _with_model(initializer: Any, model: LearnedModel) -> Any:
+    initializer.model = model
+    return initializer
 
 
 def _fix_footholds(problem: TrajoptProblem, x0: np.ndarray) -> None:
@@ -225,38 +279,56 @@ def main() -> None:
         "--table-iterations", type=int, default=30, help="iterations per Table I solve"
     )
     parser.add_argument("--skip-table", action="store_true", help="Figure 6 only")
+    parser.add_argument(
+        "--timing-tasks", type=int, default=12, help="tasks timed back to back (0: none)"
+    )
     parser.add_argument("--json", type=Path, help="output JSON (default results/init_ENV.json)")
     args = parser.parse_args()
     spec = ProblemSpec("anymal_c", args.env, "walk", 16, 5.5)
     started = time.perf_counter()
     fig6 = figure_6(args, spec)
+    times = timing(args, spec) if args.timing_tasks > 0 else {}
     table = [] if args.skip_table else table_1(args, spec)
     inits = fig6["initializers"]
     heuristic = inits["Heuristic"]
     learned = [k for k in inits if k != "Heuristic"]
     best = learned[-1] if learned else None
     print(f"Figure 6, {args.env}: {args.tasks} held-out tasks, g_max {fig6['g_max']:.4g}")
-    print(f"{'initialiser':28s} {'conv.':>6s} {'med. it':>8s} {'med. s':>8s} {'>g_max':>7s}")
+    print(
+        f"{'initialiser':28s} {'conv.':>6s} {'med. it':>8s} {'med. s':>8s} {'>g_max':>7s} "
+        f"{'>best':>7s}"
+    )
     for name, s in inits.items():
         print(
             f"{name:28s} {s['converged']:6.0%} {s['median_iterations']:8.1f} "
-            f"{s['median_solve_s']:8.3f} {s['beyond_g_max']:7.1%}"
+            f"{s['median_solve_s']:8.3f} {s['beyond_g_max']:7.1%} {s['worse_than_best']:7.1%}"
         )
+    if times:
+        print(f"timed back to back ({args.timing_tasks} tasks, medians):")
+        for name, t in times.items():
+            print(
+                f"  {name:28s} CPU {t['median_cpu_s']:.3f} s, wall {t['median_wall_s']:.3f} s, "
+                f"{t['median_iterations']:.1f} iterations, {t['cpu_per_iteration_ms']:.1f} ms "
+                "CPU/iteration"
+            )
     targets: dict[str, Any] = {}
     if best is not None:
         b = inits[best]
         ratio = heuristic["median_iterations"] / max(b["median_iterations"], 1.0)
+        cpu = times.get(best, {}).get("median_cpu_s", float("nan"))
         targets = {
             "initializer": best,
             "median_solve_s": {
                 "measured": b["median_solve_s"],
+                "measured_cpu": cpu,
                 "target": TARGETS["median_solve_s"],
             },
             "iteration_ratio": {"measured": ratio, "target": TARGETS["iteration_ratio"]},
             "beyond_g_max": {"measured": b["beyond_g_max"], "target": TARGETS["beyond_g_max"]},
         }
         print(
-            f"targets ({best}): median solve {b['median_solve_s']:.3f} s (≤ 0.25), "
+            f"targets ({best}): median solve {b['median_solve_s']:.3f} s wall, "
+            f"{cpu:.3f} s CPU (≤ 0.25), "
             f"iterations {ratio:.1f}× fewer (≥ 4), beyond g_max {b['beyond_g_max']:.1%} (≤ 1 %)"
         )
     if table:
@@ -278,6 +350,7 @@ def main() -> None:
             env=args.env,
             problem=spec.to_dict(),
             figure_6=fig6,
+            timing=times,
             table_1=table,
             targets=targets,
             wall_s=time.perf_counter() - started,

@@ -20,8 +20,10 @@ from roughwalk.trajopt import (
     optimize_motion,
     towr_config,
 )
-from roughwalk.trajopt.parameters import SolverOptions
+from roughwalk.trajopt.optimize import TrajoptProblem
+from roughwalk.trajopt.parameters import SolverOptions, TrajoptConfig
 from roughwalk.trajopt.solver import _single_threaded_blas
+from roughwalk.trajopt.task import Task
 from roughwalk.trajopt.terrain_model import TerrainModel
 from roughwalk.trajopt.variables import euler_to_rotation
 
@@ -225,6 +227,63 @@ def test_towr_feasibility_problem_reuses_its_build_and_warm_starts() -> None:
         None, "flat", task, config=config, gait="walk", steps=16, duration=3.4, warm_start=first
     )
     assert again.solved and again.iterations <= 2
+
+
+class _GuessWithMultipliers:
+    """An initialiser handing over a given guess and multipliers (as the learned one does)."""
+
+    name = "given"
+
+    def __init__(self, result: TrajoptResult) -> None:
+        self.result = result
+
+    def schedule(self, gait: object) -> object:
+        return gait
+
+    def adjust_task(self, task: object) -> object:
+        return task
+
+    def guess(self, nlp: object, task: object) -> np.ndarray:
+        return np.asarray(self.result.x)
+
+    def multipliers(self, nlp: object, task: object) -> tuple[np.ndarray, np.ndarray]:
+        return np.asarray(self.result.lam_x), np.asarray(self.result.lam_g)
+
+
+def test_warm_and_guess_options_reach_only_their_own_solves() -> None:
+    # An option IPOPT refuses, given to one set only, shows which solves use it:
+    # the cold solve (no multipliers) uses neither set.
+    from dataclasses import replace
+
+    from roughwalk.trajopt.optimize import clear_cache
+
+    base = towr_config()
+    task = ((0.0, 0.0, 0.0), (1.5, 0.0, 0.0))
+    kwargs = {"gait": "walk", "steps": 16, "duration": 3.4}
+    clear_cache()
+    broken = "no_such_ipopt_option=1"
+    warm_broken = replace(base, solver=replace(base.solver, warm_ipopt_options=(broken,)))
+    first = optimize_motion(None, "flat", task, config=warm_broken, **kwargs)
+    assert first.solved
+    with pytest.raises(RuntimeError, match="no_such_ipopt_option"):
+        optimize_motion(None, "flat", task, config=warm_broken, warm_start=first, **kwargs)
+    guess_broken = replace(base, solver=replace(base.solver, guess_ipopt_options=(broken,)))
+    again = optimize_motion(None, "flat", task, config=guess_broken, warm_start=first, **kwargs)
+    assert again.solved and again.iterations <= 2
+    with pytest.raises(RuntimeError, match="no_such_ipopt_option"):
+        _problem(guess_broken).solve(Task.from_any(task), _GuessWithMultipliers(first))
+    # With the default options a guess with multipliers (here a solution's) converges.
+    optimize_motion(None, "flat", task, config=base, **kwargs)
+    from_guess = _problem(base).solve(Task.from_any(task), _GuessWithMultipliers(first))
+    assert from_guess.solved and from_guess.iterations < first.iterations
+    clear_cache()
+
+
+def _problem(config: TrajoptConfig) -> TrajoptProblem:
+    """The cached problem built for ``config``."""
+    from roughwalk.trajopt import optimize
+
+    return next(p for p in optimize._problems.values() if p.config.solver == config.solver)
 
 
 def test_optimised_durations_stay_in_bounds_and_sum_to_the_duration() -> None:

@@ -234,3 +234,9 @@ def test_ipopt_options_are_part_of_the_structure_key() -> None:
     adaptive = TrajoptConfig(solver=SolverOptions(ipopt_options=("mu_strategy=adaptive",)))
     assert plain.structure_key() != adaptive.structure_key()
     assert plain.structure_key() == TrajoptConfig().structure_key()
+    # So are the warm-start sets: each problem holds its warm solvers too.
+    for field in ("warm_ipopt_options", "guess_ipopt_options"):
+        other = TrajoptConfig(solver=SolverOptions(**{field: ("mu_init=1e-3",)}))
+        assert plain.structure_key() != other.structure_key()
+    with pytest.raises(ConfigError, match="guess_ipopt_options entries are name=value"):
+        SolverOptions(guess_ipopt_options=("mu_init",))

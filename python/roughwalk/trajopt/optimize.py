@@ -107,6 +107,7 @@ class TrajoptProblem:
         nlp = self.formulation
         resolved = initializer.adjust_task(resolve(task, self.body, self.terrain))
         lam_x = lam_g = None
+        predicted = warm_start is None
         if warm_start is None:
             x0 = initializer.guess(nlp, resolved)
             # A guess that comes with multipliers (the learned one) warm-starts IPOPT.
@@ -132,6 +133,7 @@ class TrajoptProblem:
             callback=callback,
             lam_x0=lam_x if lam_x is not None and lam_x.size == x0.size else None,
             lam_g0=lam_g if lam_g is not None and lam_g.size == nlp.n_constraints else None,
+            predicted=predicted,
         )
         return self._result(task, outcome, build, extra_time_s)
 

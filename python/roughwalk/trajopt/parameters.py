@@ -163,6 +163,31 @@ class TerrainModelConfig:
             raise ConfigError(f"terrain.edge_slope must be > 0, got {self.edge_slope}")
 
 
+WARM_START_OPTIONS: tuple[str, ...] = (
+    "warm_start_init_point=yes",
+    "mu_init=1e-6",
+    "warm_start_bound_push=1e-9",
+    "warm_start_bound_frac=1e-9",
+    "warm_start_slack_bound_push=1e-9",
+    "warm_start_slack_bound_frac=1e-9",
+    "warm_start_mult_bound_push=1e-9",
+)
+"""IPOPT's options for a restart from a previous solution (see ``SolverOptions``)."""
+
+GUESS_START_OPTIONS: tuple[str, ...] = (
+    "warm_start_init_point=yes",
+    "mu_oracle=quality-function",
+    "warm_start_bound_push=1e-5",
+    "warm_start_bound_frac=1e-5",
+    "warm_start_slack_bound_push=1e-5",
+    "warm_start_slack_bound_frac=1e-5",
+    "warm_start_mult_bound_push=1e-5",
+    "mumps_scaling=0",
+    "mumps_permuting_scaling=0",
+)
+"""IPOPT's options for a start from predicted multipliers (see ``SolverOptions``)."""
+
+
 @dataclass(frozen=True)
 class SolverOptions:
     """IPOPT's settings and the solve's termination conditions.
@@ -200,6 +225,25 @@ class SolverOptions:
     ipopt_options:
         Further IPOPT options as "name=value" strings (numbers are converted),
         e.g. ("mu_strategy=adaptive",).
+    warm_ipopt_options:
+        IPOPT options, on top of the others, of a solve restarted from a
+        previous solution and its multipliers (``warm_start=``): IPOPT's warm
+        start, with the point and multipliers barely pushed off their bounds,
+        so that a solution is recognised in one or two iterations.
+    guess_ipopt_options:
+        IPOPT options, on top of the others, of a solve from a predicted guess
+        with predicted multipliers (the learned initialiser). Measured on
+        held-out single-pallet tasks from the learned guess: with the warm
+        options above the median was 19.5 iterations, with these (pushes
+        1e-5, quality-function barrier oracle) 14–16; larger pushes (1e-2)
+        double it. From an exact solution they take 2 iterations where the
+        warm options take 1, and on TOWR's cost-free problem (L-BFGS) 12 where
+        those take 1: a guess is not a solution. MUMPS's row/column scaling
+        is off in them: on 30 held-out tasks the iterations were identical and
+        the CPU time per iteration 13 % lower (interleaved runs).
+
+    Neither set applies to a solve from a guess without multipliers (the
+    heuristic's cold solves).
 
     """
 
@@ -213,11 +257,14 @@ class SolverOptions:
     mumps_pivot_order: int | None = None
     print_level: int = 0
     ipopt_options: tuple[str, ...] = ()
+    warm_ipopt_options: tuple[str, ...] = WARM_START_OPTIONS
+    guess_ipopt_options: tuple[str, ...] = GUESS_START_OPTIONS
 
     def __post_init__(self) -> None:
-        for item in self.ipopt_options:
-            if "=" not in item:
-                raise ConfigError(f"solver.ipopt_options entries are name=value, got {item!r}")
+        for field_name in ("ipopt_options", "warm_ipopt_options", "guess_ipopt_options"):
+            for item in getattr(self, field_name):
+                if "=" not in item:
+                    raise ConfigError(f"solver.{field_name} entries are name=value, got {item!r}")
         if self.hessian not in ("auto", "exact", "limited-memory"):
             raise ConfigError(
                 f"solver.hessian must be 'auto', 'exact' or 'limited-memory', got {self.hessian!r}"
@@ -362,6 +409,8 @@ class TrajoptConfig:
             # IPOPT's options are fixed when the solver is built, so a cached problem
             # built with other options must not be reused.
             self.solver.ipopt_options,
+            self.solver.warm_ipopt_options,
+            self.solver.guess_ipopt_options,
         )
 
 

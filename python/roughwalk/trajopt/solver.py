@@ -278,30 +278,30 @@ class TrajoptSolver:
             "error_on_fail": False,
         }
         self.solver = ca.nlpsol("trajopt", "ipopt", nlp.nlp, self._options)
-        self._warm_solver: ca.Function | None = None
+        self._warm_solvers: dict[str, ca.Function] = {}
         self.build_time_s = time.perf_counter() - start
 
-    def _warm(self) -> ca.Function:
-        """A second IPOPT that starts from given multipliers, near the end of the barrier path.
+    def _warm(self, predicted: bool) -> ca.Function:
+        """A second IPOPT that starts from given multipliers as well as the primal guess.
 
-        The derivatives are the same Functions, so it costs a fraction of a second.
+        Its options are the cold solver's with ``warm_ipopt_options`` on top
+        (a previous solution's multipliers) or ``guess_ipopt_options``
+        (``predicted`` ones). The derivatives are the same Functions, so each
+        costs a fraction of a second to build, once.
         """
-        if self._warm_solver is None:
-            push = 1e-9
-            ipopt = {
-                **self._options["ipopt"],
-                "warm_start_init_point": "yes",
-                "mu_init": 1e-6,
-                "warm_start_bound_push": push,
-                "warm_start_bound_frac": push,
-                "warm_start_slack_bound_push": push,
-                "warm_start_slack_bound_frac": push,
-                "warm_start_mult_bound_push": push,
-            }
-            self._warm_solver = ca.nlpsol(
-                "trajopt_warm", "ipopt", self.nlp.nlp, {**self._options, "ipopt": ipopt}
+        kind = "guess" if predicted else "warm"
+        if kind not in self._warm_solvers:
+            ipopt = dict(self._options["ipopt"])
+            extra = (
+                self.options.guess_ipopt_options if predicted else self.options.warm_ipopt_options
             )
-        return self._warm_solver
+            for item in extra:
+                name, _, value = item.partition("=")
+                ipopt[name.strip()] = _ipopt_value(value.strip())
+            self._warm_solvers[kind] = ca.nlpsol(
+                f"trajopt_{kind}", "ipopt", self.nlp.nlp, {**self._options, "ipopt": ipopt}
+            )
+        return self._warm_solvers[kind]
 
     def solve(
         self,
@@ -313,13 +313,15 @@ class TrajoptSolver:
         callback: Callable[[IterationInfo], bool | None] | None = None,
         lam_x0: ArrayLike | None = None,
         lam_g0: ArrayLike | None = None,
+        predicted: bool = False,
     ) -> SolveOutcome:
         """Solve for the task parameter vector ``task`` from the initial guess ``x0``.
 
         ``max_iter`` and ``time_limit_s`` [s] default to the options'; the
         ``callback`` sees every iteration and stops the solve by returning True.
-        With multipliers ``lam_x0`` and ``lam_g0`` (of a previous solution), IPOPT
-        warm-starts from them as well as from ``x0``.
+        With multipliers ``lam_x0`` and ``lam_g0`` IPOPT warm-starts from them as
+        well as from ``x0``: with the options for a previous solution's, or
+        for ``predicted`` ones (a learned guess; see :class:`SolverOptions`).
         """
         p = np.asarray(task, dtype=float).ravel()
         x_init = np.asarray(x0, dtype=float).ravel()
@@ -342,8 +344,9 @@ class TrajoptSolver:
                 "lam_x0": np.asarray(lam_x0, dtype=float),
                 "lam_g0": np.asarray(lam_g0, dtype=float),
             }
-            out = self._warm()(x0=x_init, p=p, **multipliers, **bounds)
-            stats = self._warm().stats()
+            warm = self._warm(predicted)
+            out = warm(x0=x_init, p=p, **multipliers, **bounds)
+            stats = warm.stats()
         else:
             out = self.solver(x0=x_init, p=p, **bounds)
             stats = self.solver.stats()
