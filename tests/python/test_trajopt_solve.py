@@ -356,6 +356,16 @@ def test_limits_and_callback_stop_with_their_status() -> None:
         optimize_motion(None, "flat", task, **{**SMALL, "steps": 5})
 
 
+def test_a_cached_solver_honours_each_solves_own_iteration_limit() -> None:
+    # The NLP (and its IPOPT) is cached per structure, which excludes the limits: a
+    # problem first solved with a limit of 1 must still run a later solve to its own.
+    task = ((0.0, 0.0, 0.0), (0.6, 0.0, 0.0))
+    first = optimize_motion(None, "flat", task, **{**SMALL, "solver__max_iter": 1})
+    assert first.status is TrajoptStatus.ITERATION_LIMIT and first.iterations == 1
+    later = optimize_motion(None, "flat", task, **{**SMALL, "solver__max_iter": 6})
+    assert later.status is TrajoptStatus.ITERATION_LIMIT and later.iterations == 6
+
+
 def test_footsteps_guess_from_a_plan(tmp_path: Path) -> None:
     # A hand-made plan in `roughwalk plan`'s format: start stance, then a crawl,
     # each leg 0.15 m forward.

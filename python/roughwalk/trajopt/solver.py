@@ -113,6 +113,10 @@ class SolveOutcome:
     history: list[dict[str, float]] = field(default_factory=list)
 
 
+_IPOPT_ITERATION_CEILING = 1_000_000
+"""IPOPT's own iteration limit; the per-solve limits are the monitor's."""
+
+
 def violation(
     values: NDArray[np.float64], lower: NDArray[np.float64], upper: NDArray[np.float64]
 ) -> NDArray[np.float64]:
@@ -259,7 +263,11 @@ class TrajoptSolver:
             "linear_solver": o.linear_solver,
             "hessian_approximation": self.hessian,
             **({"mumps_pivot_order": pivot_order} if o.linear_solver == "mumps" else {}),
-            "max_iter": max(o.max_iter, 1) + 1,
+            # Only a ceiling: each solve's own limit is enforced by the monitor, because
+            # IPOPT's options are fixed when the solver is built and a cached solver
+            # serves solves with other limits (one built for max_iter=0 stopped every
+            # later solve after 2 iterations).
+            "max_iter": _IPOPT_ITERATION_CEILING,
             **({"print_timing_statistics": "yes"} if o.print_level >= 5 else {}),
         }
         for item in o.ipopt_options:
