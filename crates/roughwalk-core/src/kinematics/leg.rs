@@ -300,15 +300,32 @@ impl LegChain {
     /// link `link` (0 hip, 1 thigh, 2 shank: the bodies of joints 1–3), given
     /// in that link's frame [m]. Columns of joints after `link` are zero.
     pub fn point_jacobian(&self, q: Vec3, link: usize, point: Vec3) -> CoreResult<(Vec3, Mat3)> {
+        self.point_jacobian_at(&self.link_frames(q), link, point)
+    }
+
+    /// [`Self::point_jacobian`] from the link frames `f` of the joint angles
+    /// (as [`Self::link_frames`] or the IK with frames give them), for
+    /// callers that already hold them.
+    pub fn point_jacobian_at(
+        &self,
+        f: &LinkFrames,
+        link: usize,
+        point: Vec3,
+    ) -> CoreResult<(Vec3, Mat3)> {
         if link > 2 {
             return Err(CoreError::InvalidArgument(format!(
                 "leg '{}': link index {link} out of range; valid: 0 (hip), 1 (thigh), 2 (shank)",
                 self.name
             )));
         }
-        let f = self.link_frames(q);
         let p = add(f.pos[link], mat_vec(&f.rot[link], point));
-        Ok((p, Self::columns(&f, p, link)))
+        Ok((p, Self::columns(f, p, link)))
+    }
+
+    /// The foot Jacobian ∂FK_B/∂q [m/rad] from the link frames `f` of the joint angles.
+    pub fn jacobian_at(&self, f: &LinkFrames) -> Mat3 {
+        let foot = add(f.pos[2], mat_vec(&f.rot[2], self.params.foot));
+        Self::columns(f, foot, 2)
     }
 }
 
