@@ -385,6 +385,8 @@ impl CertificateSearch<'_> {
                 // the target's radial projection: one analytic IK instead of
                 // the exact closest-point search, 30-50x dearer (§3.2 needs
                 // only the direction and size of the error).
+                // Inside it, a target the joint limits keep the foot from
+                // gets the clamped analytic solution, for the same reason.
                 let (ik, leg_frames) = match self.reach[i].aim(target) {
                     Some(aim) => match leg.ik_exact(aim, None) {
                         Some((near, near_frames)) => {
@@ -394,9 +396,9 @@ impl CertificateSearch<'_> {
                             };
                             (near, near_frames)
                         }
-                        None => leg.ik_with_frames(target, None),
+                        None => leg.ik_or_clamped(target, None),
                     },
-                    None => leg.ik_with_frames(target, None),
+                    None => leg.ik_or_clamped(target, None),
                 };
                 q[3 * i..3 * i + 3].copy_from_slice(&ik.q);
                 frames[i] = leg_frames;

@@ -184,7 +184,10 @@ impl AnalyticCandidates {
             .sqrt();
         let nominal_haa = leg.nominal()[0];
         let polar = t_w.atan2(t_n);
-        let mut haa = [v_w_abs, -v_w_abs].map(|v_w| (v_w, polar - v_w.atan2(g.lateral)));
+        // atan2 is odd in its first argument (IEEE sign symmetry, exactly):
+        // one call serves both solutions.
+        let turn = v_w_abs.atan2(g.lateral);
+        let mut haa = [(v_w_abs, polar - turn), (-v_w_abs, polar + turn)];
         if wrap_angle(haa[0].1 - nominal_haa).abs() > wrap_angle(haa[1].1 - nominal_haa).abs() {
             haa.swap(0, 1);
         }
@@ -287,20 +290,69 @@ impl LegChain {
         }
     }
 
+    /// [`Self::ik_with_frames`] where the analytic IK places the foot;
+    /// otherwise, instead of the closest-reachable search (tens of times
+    /// dearer), the analytic candidate whose joint angles, clamped into their
+    /// limits, put the foot nearest `target`: near the closest reachable foot
+    /// but not it (`reachable` false, `error` its distance [m]). For callers
+    /// that need only the direction and rough size of the foot's error, such
+    /// as the pose certificate's reachability step (Zucker 2011, §3.2).
+    pub fn ik_or_clamped(&self, target: Vec3, knee_sign: Option<f64>) -> (IkResult, LinkFrames) {
+        if !target.iter().all(|v| v.is_finite()) {
+            return self.ik_with_frames(target, knee_sign);
+        }
+        let solve_target = self.solve_target(target);
+        if let Some(found) = self.ik_exact_at(solve_target, target, knee_sign) {
+            return found;
+        }
+        let (lower, upper) = (self.params.lower, self.params.upper);
+        let candidates = AnalyticCandidates::new(self, solve_target, self.knee(knee_sign));
+        let mut best: Option<(f64, Vec3, LinkFrames)> = None;
+        for k in 0..4 {
+            let q = candidates.get(self, k);
+            let q = [0, 1, 2].map(|j| {
+                wrap_into_limits(q[j], lower[j], upper[j])
+                    .unwrap_or_else(|| wrap_angle(q[j]).clamp(lower[j], upper[j]))
+            });
+            let frames = self.link_frames(q);
+            let foot = add(frames.pos[2], mat_vec(&frames.rot[2], self.params.foot));
+            let error = norm(sub(foot, target));
+            match best {
+                Some((e, _, _)) if e <= error => {}
+                _ => best = Some((error, q, frames)),
+            }
+        }
+        let (error, q, frames) = best.expect("four candidates");
+        let on_limit =
+            (0..3).any(|k| q[k] <= lower[k] + LIMIT_SLACK || q[k] >= upper[k] - LIMIT_SLACK);
+        let reachable = error <= IK_TOLERANCE;
+        let result = IkResult {
+            q,
+            reachable,
+            within_limits: reachable || !on_limit,
+            error,
+        };
+        (result, frames)
+    }
+
+    /// The knee branch to prefer, ±1.
+    fn knee(&self, knee_sign: Option<f64>) -> f64 {
+        if knee_sign.unwrap_or(self.params.knee_sign) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+
     fn ik_exact_at(
         &self,
         solve_target: Vec3,
         target: Vec3,
         knee_sign: Option<f64>,
     ) -> Option<(IkResult, LinkFrames)> {
-        let knee = if knee_sign.unwrap_or(self.params.knee_sign) < 0.0 {
-            -1.0
-        } else {
-            1.0
-        };
         // Candidates are built one at a time: the first usually fits, and
         // each costs a handful of atan2/acos/sin_cos.
-        let candidates = AnalyticCandidates::new(self, solve_target, knee);
+        let candidates = AnalyticCandidates::new(self, solve_target, self.knee(knee_sign));
         for k in 0..4 {
             let q = candidates.get(self, k);
             let wrapped = [0, 1, 2]
@@ -477,6 +529,18 @@ mod tests {
                 }
                 None => prop_assert!(!r.reachable, "{r:?}"),
             }
+            // The cheap variant: the same where the analytic IK reaches; else
+            // within limits, its frames and error consistent, never nearer
+            // than the closest reachable foot, which it approximates.
+            let (c, frames) = leg.ik_or_clamped(target, None);
+            prop_assert_eq!(frames, leg.link_frames(c.q));
+            if let Some((exact, _)) = leg.ik_exact(target, None) {
+                prop_assert_eq!(c, exact);
+            } else {
+                prop_assert!(!c.reachable && leg.is_within_limits(c.q), "{c:?}");
+                prop_assert!((norm(sub(leg.fk(c.q), target)) - c.error).abs() < 1e-12);
+                prop_assert!(c.error >= r.error - 1e-9, "{c:?} vs closest {r:?}");
+            }
         }
     }
 
@@ -488,5 +552,6 @@ mod tests {
         let (r, frames) = leg.ik_with_frames([f64::NAN, 0.0, 0.0], None);
         assert_eq!(frames, leg.link_frames(r.q));
         assert!(!r.reachable);
+        assert_eq!(leg.ik_or_clamped([f64::NAN, 0.0, 0.0], None), (r, frames));
     }
 }
