@@ -18,6 +18,9 @@ const LIPSCHITZ: f64 = 1.732_050_808_568_877_3;
 /// The field's value [m] at `p` without its gradient (the trilinear value of
 /// the lattice cell, or the exact fall-back outside the lattice): capsule
 /// marching needs only values, and the gradient only at the minimum.
+// Measured: LLVM left these out of the capsule-marching loop, ~6 % of a
+// certificate's instructions on the rocky probe.
+#[allow(clippy::inline_always)]
 #[inline(always)]
 fn distance(sdf: &SignedDistanceField, p: Vec3) -> f64 {
     match sdf.grid().value(p) {

@@ -94,8 +94,9 @@ pub struct LegChain {
     arcs: Vec<closest::PlanarArc>,
     /// The HAA scan of the closest-point search.
     scan: closest::HaaScan,
-    /// Each joint's hinge in its parent body's frame.
-    hinges: [Hinge; 3],
+    /// Each joint's hinge in its parent body's frame (boxed: legs are
+    /// passed around by value in arrays of four).
+    hinges: Box<[Hinge; 3]>,
 }
 
 /// Joint k's hinge transform with everything that does not depend on q_k
@@ -216,7 +217,7 @@ impl LegChain {
         let ik_geometry = ik::IkGeometry::new(name, &params, &body_rot)?;
         let arcs = closest::planar_arcs(&ik_geometry, params.lower, params.upper);
         let scan = closest::haa_scan(&ik_geometry, params.lower, params.upper);
-        let hinges = [0, 1, 2].map(|k| Hinge::new(&params, &body_rot, k));
+        let hinges = Box::new([0, 1, 2].map(|k| Hinge::new(&params, &body_rot, k)));
         Ok(Self {
             name: name.to_owned(),
             params,
@@ -466,11 +467,11 @@ pub(crate) mod tests {
                 let q = sample_q(&leg, u);
                 let f = leg.link_frames(q);
                 let (mut pos, mut r) = ([0.0; 3], crate::kinematics::math::IDENTITY);
-                for k in 0..3 {
+                for (k, &angle) in q.iter().enumerate() {
                     let placed = mat_mul(&r, &quat_to_mat(p.body_quat[k]));
                     let origin = add(pos, mat_vec(&r, p.body_pos[k]));
                     let anchor = add(origin, mat_vec(&placed, p.anchor[k]));
-                    r = mat_mul(&placed, &rot(p.axis[k], q[k]));
+                    r = mat_mul(&placed, &rot(p.axis[k], angle));
                     pos = sub(anchor, mat_vec(&r, p.anchor[k]));
                     let close = |a: Vec3, b: Vec3| norm(sub(a, b)) < 1e-14;
                     assert!(

@@ -164,6 +164,9 @@ impl DistanceGrid {
 
     /// The cell holding `p` [m]: linear index of its lowest corner and the
     /// fractions (t_x, t_y, t_z) ∈ [0, 1]³, or None outside the node box.
+    // Measured: LLVM left these out of the capsule-marching loop, ~6 % of a
+    // certificate's instructions on the rocky probe.
+    #[allow(clippy::inline_always)]
     #[inline(always)]
     pub fn locate(&self, p: [f64; 3]) -> Option<(usize, [f64; 3])> {
         let o = &self.spec.origin;
@@ -185,6 +188,9 @@ impl DistanceGrid {
     /// The trilinear value [m] at `p` [m] without its gradient, or None
     /// outside the node box: the same number as [`Self::trilinear`]'s value,
     /// for the hot loops that need only values (capsule marching).
+    // Measured: LLVM left these out of the capsule-marching loop, ~6 % of a
+    // certificate's instructions on the rocky probe.
+    #[allow(clippy::inline_always)]
     #[inline(always)]
     pub fn value(&self, p: [f64; 3]) -> Option<f64> {
         let (base, [tx, ty, tz]) = self.locate(p)?;
@@ -201,6 +207,9 @@ impl DistanceGrid {
 
     /// The eight corner values of the cell whose lowest corner is `base`,
     /// ordered (x, y, z) = 000, 001, 010, 011, 100, 101, 110, 111.
+    // Measured: LLVM left these out of the capsule-marching loop, ~6 % of a
+    // certificate's instructions on the rocky probe.
+    #[allow(clippy::inline_always)]
     #[inline(always)]
     pub fn corners(&self, base: usize) -> [f32; 8] {
         let [sx, nz] = self.stride;
