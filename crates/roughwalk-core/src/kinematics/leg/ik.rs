@@ -18,6 +18,14 @@ use crate::kinematics::math::{
 /// between axes that must be perpendicular, |sin| between axes that must be parallel.
 const STRUCTURE_TOLERANCE: f64 = 1e-6;
 
+/// Polishing Newton steps start only this close to the target [m]: a
+/// candidate of a chain within [`STRUCTURE_TOLERANCE`] of the analytic
+/// structure lands within about that times the leg's length of a target it
+/// can reach; one farther off is out of this candidate's reach, and the
+/// steps would only be wasted on it (the other candidates cover the other
+/// solutions).
+const NEWTON_RANGE: f64 = 1e-5;
+
 /// Targets farther than this from the hip [m] are pulled in along their direction
 /// before solving: no leg reaches that far, and it keeps squares finite.
 const FAR_TARGET: f64 = 1e3;
@@ -158,6 +166,13 @@ pub(super) fn wrap_into_limits(q: f64, lower: f64, upper: f64) -> Option<f64> {
     let tau = std::f64::consts::TAU;
     let v = w + tau * ((lo - w) / tau).ceil();
     (v <= hi).then(|| v.clamp(lower, upper))
+}
+
+/// What the analytic IK found: a candidate that reaches the target, or the
+/// nearest one (error [m], q, frames) if it was asked for.
+enum Analytic {
+    Reached(IkResult, LinkFrames),
+    Nearest(Option<(f64, Vec3, LinkFrames)>),
 }
 
 /// The four solutions (2 HAA × 2 knee branches) of the limit-free chain,
@@ -302,27 +317,11 @@ impl LegChain {
             return self.ik_with_frames(target, knee_sign);
         }
         let solve_target = self.solve_target(target);
-        if let Some(found) = self.ik_exact_at(solve_target, target, knee_sign) {
-            return found;
-        }
+        let (error, q, frames) = match self.analytic(solve_target, target, knee_sign, true) {
+            Analytic::Reached(result, frames) => return (result, frames),
+            Analytic::Nearest(nearest) => nearest.expect("four clamped candidates"),
+        };
         let (lower, upper) = (self.params.lower, self.params.upper);
-        let candidates = AnalyticCandidates::new(self, solve_target, self.knee(knee_sign));
-        let mut best: Option<(f64, Vec3, LinkFrames)> = None;
-        for k in 0..4 {
-            let q = candidates.get(self, k);
-            let q = [0, 1, 2].map(|j| {
-                wrap_into_limits(q[j], lower[j], upper[j])
-                    .unwrap_or_else(|| wrap_angle(q[j]).clamp(lower[j], upper[j]))
-            });
-            let frames = self.link_frames(q);
-            let foot = add(frames.pos[2], mat_vec(&frames.rot[2], self.params.foot));
-            let error = norm(sub(foot, target));
-            match best {
-                Some((e, _, _)) if e <= error => {}
-                _ => best = Some((error, q, frames)),
-            }
-        }
-        let (error, q, frames) = best.expect("four candidates");
         let on_limit =
             (0..3).any(|k| q[k] <= lower[k] + LIMIT_SLACK || q[k] >= upper[k] - LIMIT_SLACK);
         let reachable = error <= IK_TOLERANCE;
@@ -350,14 +349,32 @@ impl LegChain {
         target: Vec3,
         knee_sign: Option<f64>,
     ) -> Option<(IkResult, LinkFrames)> {
+        match self.analytic(solve_target, target, knee_sign, false) {
+            Analytic::Reached(result, frames) => Some((result, frames)),
+            Analytic::Nearest(_) => None,
+        }
+    }
+
+    /// The first analytic candidate, in order of preference, that reaches
+    /// `target` within the joint limits; otherwise, with `nearest`, the
+    /// candidate (clamped into the limits where it leaves them) whose foot
+    /// is nearest, as (error [m], q, frames).
+    fn analytic(
+        &self,
+        solve_target: Vec3,
+        target: Vec3,
+        knee_sign: Option<f64>,
+        nearest: bool,
+    ) -> Analytic {
+        let (lower, upper) = (self.params.lower, self.params.upper);
         // Candidates are built one at a time: the first usually fits, and
         // each costs a handful of atan2/acos/sin_cos.
         let candidates = AnalyticCandidates::new(self, solve_target, self.knee(knee_sign));
+        let mut best: Option<(f64, Vec3, LinkFrames)> = None;
         for k in 0..4 {
             let q = candidates.get(self, k);
-            let wrapped = [0, 1, 2]
-                .map(|k| wrap_into_limits(q[k], self.params.lower[k], self.params.upper[k]));
-            if let [Some(a), Some(b), Some(c)] = wrapped {
+            let wrapped = [0, 1, 2].map(|k| wrap_into_limits(q[k], lower[k], upper[k]));
+            let (q, error, frames) = if let [Some(a), Some(b), Some(c)] = wrapped {
                 let (q, error, frames) = self.polish([a, b, c], target);
                 if error <= IK_TOLERANCE {
                     let result = IkResult {
@@ -366,11 +383,26 @@ impl LegChain {
                         within_limits: true,
                         error,
                     };
-                    return Some((result, frames));
+                    return Analytic::Reached(result, frames);
                 }
+                (q, error, frames)
+            } else if nearest {
+                let q = [0, 1, 2].map(|j| {
+                    wrapped[j].unwrap_or_else(|| wrap_angle(q[j]).clamp(lower[j], upper[j]))
+                });
+                let frames = self.link_frames(q);
+                let foot = add(frames.pos[2], mat_vec(&frames.rot[2], self.params.foot));
+                (q, norm(sub(foot, target)), frames)
+            } else {
+                continue;
+            };
+            match best {
+                Some((e, _, _)) if e <= error => {}
+                _ if nearest => best = Some((error, q, frames)),
+                _ => {}
             }
         }
-        None
+        Analytic::Nearest(best)
     }
 
     /// The target relative to the HAA anchor, in the hip frame at q_HAA = 0 [m].
@@ -391,7 +423,7 @@ impl LegChain {
         let (mut q, (mut foot, mut frames)) = (q, fk(q));
         let mut error = norm(sub(foot, target));
         for _ in 0..4 {
-            if error <= 1e-14 {
+            if error <= 1e-14 || error > NEWTON_RANGE {
                 break;
             }
             let jacobian = Self::columns(&frames, foot, 2);
