@@ -161,9 +161,11 @@ class SwingConfig:
         2.3–3.8 times their means on LittleDog). Measured in MuJoCo with
         ``lift_fraction`` 0.3: swings 0.42–0.64 → 0.30–0.36 s, flat 3.3 →
         4.6 cm/s, barrier 3.1 → 4.2, steps 3.0 → 4.2 (one of two steps runs
-        fell), round rocks 2.6 → 3.2 (same 1 of 2 successes); but a 1 N·s
-        side push during the walk was survived at 4 of 4 push times with
-        "knots" and only 1 of 4 with "even", so it is not the default yet.
+        fell), round rocks 2.6 → 3.2 (same 1 of 2 successes). Under a
+        1 N·s side push on flat ground both survive about half the push
+        times (9 times from 1.6 to 3.2 s: "even" 4, "knots" 5), but the
+        push test of ``test_sim_run`` (2.0 s) falls with "even", so it is
+        not the default until recovery copes with every phase.
     vertical_weight:
         With ``"even"``: one metre of vertical foot motion counts like this
         many metres of horizontal motion (LittleDog's hip and knee turn about
