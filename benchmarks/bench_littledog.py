@@ -18,7 +18,11 @@ runs on generated large rocks under a lateral push, a friction drop and a
 ±1 cm error in the map the planner sees, and reports how many runs the
 reflexes and re-planning rescued (succeeded after at least one reflex).
 
-Run: ``roughwalk bench littledog [--seeds N] [--full] [--disturbances] [--jobs N]``.
+Run: ``roughwalk bench littledog [--seeds N] [--full] [--disturbances] [--jobs N]
+[--set KEY=VALUE ...]``; ``--set`` overrides a simulation setting
+(``executor.compute_time_scale=0`` charges no planning time, so results do
+not depend on the machine's load) or, prefixed ``trajectory.``, a setting
+of trajectory generation (``trajectory.swing.time_law=even``).
 With ``--jobs`` runs go to N processes at once; every run's on-line
 planning and optimisation is charged in wall time, so on a machine with
 fewer free cores than jobs the waits, and so the speeds, suffer.
@@ -74,13 +78,20 @@ def one_run(
     goal: tuple[float, float],
     plan_time: float,
     disturbances: list[Any],
+    sets: tuple[tuple[str, str], ...] = (),
 ) -> dict[str, Any]:
     """Run once; the result's JSON fields plus the wall time.
+
+    ``sets``: (dotted key, value) overrides; keys under ``trajectory.`` go to
+    trajectory generation, the others to the simulation.
 
     Where the start stance has no pose certificate (feet on a rock edge), the
     start moves forward 3 cm at a time, up to three times, as a trial's
     operator would place the robot.
     """
+    sim = {k: v for k, v in sets if not k.startswith("trajectory.")}
+    traj = {k.removeprefix("trajectory."): v for k, v in sets if k.startswith("trajectory.")}
+    trajectory_config = rw.trajectories.trajectory_config(**traj) if traj else None
     began = time.perf_counter()
     for shift in (0.0, 0.03, 0.06, 0.09):
         result = run(
@@ -89,7 +100,8 @@ def one_run(
             (start[0] + shift, start[1], start[2]),
             goal,
             disturbances=disturbances,
-            **{"executor.initial_plan_s": plan_time},
+            trajectory_config=trajectory_config,
+            **{"executor.initial_plan_s": plan_time, **sim},
         )
         if not result.outcome.reason.startswith("no plan: start stance"):
             break
@@ -99,15 +111,17 @@ def one_run(
     return out
 
 
-def seeded_run(
-    args: tuple[str, int, bool, float, str | None, float],
-) -> dict[str, Any]:
+Job = tuple[str, int, bool, float, str | None, float, tuple[tuple[str, str], ...]]
+
+
+def seeded_run(args: Job) -> dict[str, Any]:
     """One benchmark run from picklable arguments (for a process pool).
 
     ``args``: terrain class, seed, full, plan time [s], disturbance name
-    (None, "push", "friction", "map") and push impulse [N·s].
+    (None, "push", "friction", "map"), push impulse [N·s] and ``--set``
+    overrides.
     """
-    kind, seed, full, plan_time, disturbance, push = args
+    kind, seed, full, plan_time, disturbance, push, sets = args
     spec, start, goal = course(kind, seed, full)
     made: list[Any] = []
     if disturbance is not None:
@@ -120,7 +134,7 @@ def seeded_run(
             made = [FrictionDrop(0.5)]
         else:
             made = [MapError(0.01, seed=seed - 100)]
-    r = one_run(spec, start, goal, plan_time, made)
+    r = one_run(spec, start, goal, plan_time, made, sets)
     r["seed"] = seed
     return r
 
@@ -175,7 +189,28 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--push", type=float, default=0.6, help="lateral push impulse [N·s]")
     ap.add_argument("--json", default=str(RESULTS), help="where to write the results")
     ap.add_argument("--jobs", type=int, default=1, help="runs at once (processes)")
+    ap.add_argument(
+        "--set",
+        metavar="KEY=VALUE",
+        action="append",
+        default=[],
+        help="override a simulation setting, or with a 'trajectory.' prefix a trajectory "
+        "setting (repeatable, dotted keys)",
+    )
     args = ap.parse_args(argv)
+    sets: list[tuple[str, str]] = []
+    for item in args.set:
+        key, eq, value = item.partition("=")
+        if not eq or not key.strip():
+            ap.error(f"--set takes KEY=VALUE, got {item!r}")
+        sets.append((key.strip(), value.strip()))
+    try:
+        rw.sim.sim_config(**{k: v for k, v in sets if not k.startswith("trajectory.")})
+        rw.trajectories.trajectory_config(
+            **{k.removeprefix("trajectory."): v for k, v in sets if k.startswith("trajectory.")}
+        )
+    except rw.ConfigError as e:
+        ap.error(str(e))
     seeds = args.seeds if args.seeds is not None else (10 if args.full else 2)
     classes = [c.strip() for c in args.classes.split(",") if c.strip()]
     unknown = set(classes) - set(CLASSES)
@@ -190,8 +225,12 @@ def main(argv: list[str] | None = None) -> int:
     print("-" * len(header))
     table: dict[str, Any] = {}
     load_before = os.getloadavg()
-    jobs: dict[str, list[tuple[str, int, bool, float, str | None, float]]] = {
-        kind: [(kind, seed, args.full, args.plan_time, None, args.push) for seed in range(seeds)]
+    frozen = tuple(sets)
+    jobs: dict[str, list[Job]] = {
+        kind: [
+            (kind, seed, args.full, args.plan_time, None, args.push, frozen)
+            for seed in range(seeds)
+        ]
         for kind in classes
     }
     if args.disturbances or args.full:
@@ -201,7 +240,7 @@ def main(argv: list[str] | None = None) -> int:
             ("large_rocks + map error ±1 cm", "map"),
         ):
             jobs[key] = [
-                ("large_rocks", seed + 100, args.full, args.plan_time, name, args.push)
+                ("large_rocks", seed + 100, args.full, args.plan_time, name, args.push, frozen)
                 for seed in range(seeds)
             ]
     with ProcessPoolExecutor(max_workers=args.jobs) as pool:
@@ -225,6 +264,7 @@ def main(argv: list[str] | None = None) -> int:
             full=args.full,
             plan_time_s=args.plan_time,
             jobs=args.jobs,
+            overrides=dict(sets),
             load_average_before=list(load_before),
             load_average_after=list(os.getloadavg()),
             target_cm_s=TARGET_CM_S,

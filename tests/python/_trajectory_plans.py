@@ -70,12 +70,18 @@ def barrier_step_plan(
 def low_swing_config(**more: Any) -> dict[str, Any]:
     """Settings whose swing spline ignores the terrain and lifts 2 cm: it hits a 4 cm barrier.
 
+    It lifts nearly vertically on the knot timing (lift-off at 0.1 of the
+    stride, the defaults before the re-timed swing), so that CHOMP has the
+    same deep collision to repair.
+
     Validity asks for 2 mm of clearance and no dip of the foot, so that an
     independent check can prove the result collision-free.
     """
     return {
         "swing.scan_terrain": False,
         "swing.lift_height": 0.02,
+        "swing.lift_fraction": 0.1,
+        "swing.time_law": "knots",
         "zmp.shortcut": False,
         "validity.foot_tolerance": 0.0,
         "validity.min_clearance": 0.002,

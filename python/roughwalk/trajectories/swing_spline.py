@@ -9,6 +9,15 @@ at the interior waypoints chosen per coordinate as Fritsch–Carlson do for
 monotone cubics (zero where the path turns) and capped at twice the slope of
 either neighbouring segment, which keeps these quintics monotone too, and
 waypoint times proportional to segment lengths.
+
+That path's own timing stops the foot vertically at lift-off and drop-off
+and dashes through the short lift and drop segments: its peak joint speeds
+are 2.5–3.5 times their means, and the swing's duration is set by the peak
+against the velocity limits (§5.2). With ``SwingConfig.time_law = "even"``
+the same path is re-timed so the foot moves at a steady speed in a metric
+that weights vertical motion by ``vertical_weight`` (lifting the foot costs
+LittleDog's hip and knee more than moving it forward), with smooth
+start-up and slow-down over ``ramp_fraction`` of the time at each end.
 """
 
 from __future__ import annotations
@@ -17,6 +26,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.interpolate import CubicSpline
 
 from roughwalk.errors import InvalidArgumentError
 from roughwalk.trajectories.config import SwingConfig
@@ -24,7 +34,37 @@ from roughwalk.trajectories.config import SwingConfig
 if TYPE_CHECKING:
     from roughwalk.terrain.terrain import Terrain
 
-__all__ = ["SwingSpline"]
+__all__ = ["SwingSpline", "ramp_profile"]
+
+_TABLE = 2001
+"""Samples of the path parameter used to invert its arc length."""
+_NODES = 121
+"""Nodes of the cubic time law u(t)."""
+_STOP_SHARE = 0.1
+"""Share of the mean weighted speed added to it everywhere (see ``_even_law``)."""
+
+
+def ramp_profile(tau: ArrayLike, ramp: float) -> NDArray[np.float64]:
+    """Fraction of the way (0 → 1) at time fractions ``tau`` ∈ [0, 1], ramp fraction ``ramp``.
+
+    The speed rises from rest as a smoothstep over the first ``ramp`` of the
+    time, holds, and falls symmetrically over the last: peak over mean speed
+    1 / (1 − ramp), zero speed and acceleration at both ends.
+    """
+    x = np.clip(np.asarray(tau, dtype=float), 0.0, 1.0)
+    if ramp <= 0:
+        return x
+    scale = 1.0 / (1.0 - ramp)
+
+    def rise(t: NDArray[np.float64]) -> NDArray[np.float64]:
+        y = np.clip(t / ramp, 0.0, 1.0)
+        return ramp * (y**3 - 0.5 * y**4) + np.maximum(t - ramp, 0.0)
+
+    first = np.minimum(x, 0.5)
+    out = rise(first)
+    late = x > 0.5
+    out[late] = 2 * rise(np.array(0.5)) - rise(1.0 - x[late])
+    return out * scale
 
 
 def _interior_slopes(
@@ -56,9 +96,20 @@ class SwingSpline:
         (K, 3) positions [m], K ≥ 2: start, ..., target.
     duration:
         Time [s] from start to target.
+    config:
+        With ``time_law == "even"``, the path is re-timed to a steady speed
+        (see the module notes); otherwise (or without it) each segment takes
+        time in proportion to its length.
+
+    Attributes
+    ----------
+    times:
+        When the foot passes each waypoint [s].
     """
 
-    def __init__(self, waypoints: ArrayLike, duration: float) -> None:
+    def __init__(
+        self, waypoints: ArrayLike, duration: float, config: SwingConfig | None = None
+    ) -> None:
         p = np.asarray(waypoints, dtype=float)
         if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 2 or not np.all(np.isfinite(p)):
             raise InvalidArgumentError(f"swing waypoints must be finite (K ≥ 2, 3), got {p.shape}")
@@ -70,8 +121,46 @@ class SwingSpline:
         seg = np.maximum(seg, 0.1 * seg.mean() + 1e-9)
         self.waypoints = p
         self.duration = float(duration)
-        self.times = np.concatenate([[0.0], np.cumsum(seg) / seg.sum() * duration])
-        self.velocities = _interior_slopes(p, self.times)
+        self.knots = np.concatenate([[0.0], np.cumsum(seg) / seg.sum() * duration])
+        self.velocities = _interior_slopes(p, self.knots)
+        self._law: CubicSpline | None = None
+        self.times = self.knots
+        if config is not None and config.time_law == "even":
+            self._law = self._even_law(config.vertical_weight, config.ramp_fraction)
+            if self._law is not None:
+                self.times = self._pass_times()
+
+    def _even_law(self, vertical_weight: float, ramp: float) -> CubicSpline | None:
+        """The path parameter u(t) [s] for a steady weighted speed, or None (keep the knots)."""
+        u = np.linspace(0.0, self.duration, _TABLE)
+        _, du, _ = self._evaluate_path(u)
+        speed = np.linalg.norm(du * [1.0, 1.0, vertical_weight], axis=1)
+        if not np.all(np.isfinite(speed)) or speed.max() <= 0:
+            return None
+        # A share of the mean keeps the arc length strictly increasing and makes
+        # the foot slow down where its path stops (stepping in place, a corner
+        # with lift_fraction 0): there u′ stays finite, so the velocity p′·u′
+        # goes to zero instead of flipping at once.
+        speed = speed + _STOP_SHARE * speed.mean()
+        arc = np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(u))])
+        t = np.linspace(0.0, self.duration, _NODES)
+        nodes = np.interp(ramp_profile(t / self.duration, ramp) * arc[-1], arc, u)
+        nodes[0], nodes[-1] = 0.0, self.duration
+        # The path's rate does not vanish at its ends, so the ramp's start from
+        # rest is u′ = 0 there.
+        law = CubicSpline(t, nodes, bc_type=((1, 0.0), (1, 0.0)))
+        dense = np.linspace(0.0, self.duration, 4 * _NODES)
+        if np.any(np.diff(law(dense)) < 0) or np.any(law(dense, 1) < -1e-9):
+            return None
+        return law
+
+    def _pass_times(self) -> NDArray[np.float64]:
+        """Times [s] at which the re-timed foot passes the path's knots."""
+        assert self._law is not None
+        t = np.linspace(0.0, self.duration, _TABLE)
+        out = np.interp(self.knots, self._law(t), t)
+        out[0], out[-1] = 0.0, self.duration
+        return out
 
     @classmethod
     def plan(
@@ -109,15 +198,15 @@ class SwingSpline:
         lift = s + f * (t - s)
         drop = t - f * (t - s)
         lift[2] = drop[2] = top
-        return cls(np.array([s, lift, drop, t]), duration)
+        return cls(np.array([s, lift, drop, t]), duration, config)
 
     def _segments(
         self, t: ArrayLike
     ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.float64]]:
         tt = np.clip(np.asarray(t, dtype=float), 0.0, self.duration)
-        i = np.clip(np.searchsorted(self.times, tt, side="right") - 1, 0, len(self.times) - 2)
-        h = self.times[i + 1] - self.times[i]
-        return i, (tt - self.times[i]) / h, h
+        i = np.clip(np.searchsorted(self.knots, tt, side="right") - 1, 0, len(self.knots) - 2)
+        h = self.knots[i + 1] - self.knots[i]
+        return i, (tt - self.knots[i]) / h, h
 
     def evaluate(
         self, t: ArrayLike
@@ -126,6 +215,19 @@ class SwingSpline:
 
         Times outside [0, duration] are clamped (the foot rests at its ends).
         """
+        if self._law is None:
+            return self._evaluate_path(t)
+        tt = np.clip(np.atleast_1d(np.asarray(t, dtype=float)), 0.0, self.duration)
+        u = np.clip(self._law(tt), 0.0, self.duration)
+        du = self._law(tt, 1)[:, None]
+        ddu = self._law(tt, 2)[:, None]
+        pos, vel, acc = self._evaluate_path(u)
+        return pos, vel * du, acc * du * du + vel * ddu
+
+    def _evaluate_path(
+        self, t: ArrayLike
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """The path and its derivatives at path parameters ``t`` (its own chord timing)."""
         i, s, h = self._segments(t)
         s = s[:, None]
         h = h[:, None]
