@@ -147,7 +147,7 @@ def run_job(job: Job) -> dict[str, Any]:
             Task(job.start, job.goal),
             config=config,
             init=job.init,
-            solver__max_iter=max(job.max_iter, 0),
+            max_iter=max(job.max_iter, 0),
         )
     except Exception as e:  # noqa: BLE001  (a failed solve is a data point, not a crash)
         row.update(success=False, reason=f"solve raised {type(e).__name__}: {e}")

@@ -31,6 +31,8 @@ from roughwalk.sim.measured_state import MeasuredState, measure
 from roughwalk.sim.world import World
 from roughwalk.tracking.config import TrackingConfig
 from roughwalk.tracking.contact_state import ContactEstimate, ContactStateMachine, LegContact
+from roughwalk.tracking.reach import LegReach
+from roughwalk.tracking.swing import SwingPlanner, SwingTrajectory
 from roughwalk.tracking.tasks import LeastSquaresTask, force_task, motion_task, regularisation
 from roughwalk.tracking.whole_body_qp import QPSolution, WholeBodyQP
 
@@ -161,6 +163,15 @@ class WholeBodyController:
         self._jacp = np.zeros((3, self.nv))
         self._jacdot = np.zeros((3, self.nv))
         self._scratch = mujoco.MjData(m)
+        reach = LegReach(world.robot, cfg.min_knee_bend_rad)
+        lower, upper = reach.joint_range(cfg.min_knee_bend_rad, cfg.max_knee_bend_rad)
+        self._joint_lower, self._joint_upper = lower, upper
+        self.swing_planner = (
+            SwingPlanner(world.terrain, self.foot_radius, cfg.swing_clearance_m)
+            if cfg.terrain_swings
+            else None
+        )
+        self._swings: list[SwingTrajectory | None] = [None] * 4
 
     # ---- one tick -------------------------------------------------------------------
 
@@ -198,7 +209,15 @@ class WholeBodyController:
             np.where(estimate.slipping[stance], self.config.gains.slip_friction_scale, 1.0)
             * self.config.friction
         )
-        solution = self.qp.solve(self._mass, h, jc, tasks, contact_bias=hard, friction=friction)
+        solution = self.qp.solve(
+            self._mass,
+            h,
+            jc,
+            tasks,
+            contact_bias=hard,
+            friction=friction,
+            qacc_bounds=self._qacc_bounds(),
+        )
         qp_forces = np.zeros((4, 3))
         if solution.success:
             self.torques = solution.tau
@@ -215,6 +234,42 @@ class WholeBodyController:
             qp_forces,
             time.perf_counter() - started,
         )
+
+    def _swing_for(
+        self,
+        leg: int,
+        ref: ReferenceSample,
+        foot: NDArray[np.float64],
+        shift: NDArray[np.float64],
+    ) -> SwingTrajectory | None:
+        """The leg's own swing (made at lift-off), or None to follow the planned splines."""
+        if self.swing_planner is None or ref.swing_end is None:
+            return None
+        end = float(ref.swing_end[leg])
+        current = self._swings[leg]
+        if not np.isfinite(end):
+            # Planned stance: a late foot keeps the swing it had.
+            return current
+        if current is None or current.t1 != end:
+            planned = self.reference(end).feet_pos[leg] + shift
+            target = self.swing_planner.foothold(planned)
+            target[2] -= self.config.touchdown_depth_m
+            current = self.swing_planner.swing(foot, target, ref.t, end)
+            self._swings[leg] = current
+        return current
+
+    def _qacc_bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(nv,) q̈ bounds keeping q + q̇h + ½q̈h² within the joints' kept range."""
+        world, d = self.world, self.world.data
+        h = self.config.joint_limit_horizon_s
+        q = d.qpos[world.joint_qpos]
+        ahead = q + d.qvel[world.joint_dof] * h
+        lower = np.full(self.nv, -np.inf)
+        upper = np.full(self.nv, np.inf)
+        with np.errstate(invalid="ignore"):
+            lower[world.joint_dof] = 2.0 * (self._joint_lower - ahead) / (h * h)
+            upper[world.joint_dof] = 2.0 * (self._joint_upper - ahead) / (h * h)
+        return lower, upper
 
     def _com_jacobian(
         self,
@@ -336,12 +391,15 @@ class WholeBodyController:
                 )
                 continue
             target, target_vel, target_acc = ref.feet_pos[leg], ref.feet_vel[leg], ref.feet_acc[leg]
-            if s == LegContact.SWING:
+            swing = self._swing_for(leg, ref, points[leg], shift)
+            if s == LegContact.SWING and swing is not None:
+                target, target_vel, target_acc = swing(ref.t)
+            elif s == LegContact.SWING:
                 blend = float(np.clip(ref.swing_progress[leg], 0.0, 1.0))
                 target = target + blend * shift
             if s == LegContact.LATE_TOUCHDOWN:
                 # Keep reaching down until the ground is found (or too deep).
-                target = target + shift
+                target = swing.target if swing is not None else target + shift
                 depth = min(c.search_speed_m_s * estimate.late_since[leg], c.search_depth_m)
                 target = target - depth * _Z
                 target_vel = -c.search_speed_m_s * _Z if depth < c.search_depth_m else np.zeros(3)

@@ -38,6 +38,8 @@ class TrackingLog:
         (n, 4) planned contact and the contact state machine's stance.
     torques:
         (n, 12) joint torques sent [N·m].
+    shin_contact:
+        (n, 4) a leg link other than the foot touches the terrain.
     qpos:
         (n, nq) MuJoCo ``qpos`` (for videos).
     """
@@ -54,6 +56,7 @@ class TrackingLog:
     contact_ref: NDArray[np.bool_]
     stance: NDArray[np.bool_]
     torques: NDArray[np.float64]
+    shin_contact: NDArray[np.bool_]
     qpos: NDArray[np.float64]
 
     @property

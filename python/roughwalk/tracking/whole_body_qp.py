@@ -121,6 +121,7 @@ class WholeBodyQP:
         normals: ArrayLike | None = None,
         contact_bias: ArrayLike | None = None,
         friction: ArrayLike | None = None,
+        qacc_bounds: tuple[ArrayLike, ArrayLike] | None = None,
     ) -> QPSolution:
         """Minimise Σ w‖A x − b‖² subject to dynamics, friction and torque limits.
 
@@ -141,6 +142,10 @@ class WholeBodyQP:
             J_c q̈ + J̇_c q̇ = 0, as a hard constraint (else it is up to the tasks).
         friction:
             (nc,) μ per stance foot (default: the solver's μ for all).
+        qacc_bounds:
+            (nv,) lower and upper bounds on q̈ (±inf where free): joint limits
+            turned into acceleration bounds by the caller. When they make the
+            QP infeasible it is solved again without them.
         """
         m = np.asarray(mass_matrix, dtype=float)
         h = np.asarray(bias, dtype=float)
@@ -194,9 +199,18 @@ class WholeBodyQP:
             p += aw.T @ task.matrix
             q -= aw.T @ task.target
         p = 0.5 * (p + p.T) + 1e-9 * np.eye(n)
-        x = self._solve_qp(
-            p, q, G=g, h=g_h, A=a_eq, b=b_eq, solver=self.solver, **_solver_options(self.solver)
-        )
+        options = _solver_options(self.solver)
+        x = None
+        if qacc_bounds is not None:
+            lb = np.full(n, -np.inf)
+            ub = np.full(n, np.inf)
+            lb[lay.qacc] = qacc_bounds[0]
+            ub[lay.qacc] = qacc_bounds[1]
+            x = self._solve_qp(
+                p, q, G=g, h=g_h, A=a_eq, b=b_eq, lb=lb, ub=ub, solver=self.solver, **options
+            )
+        if x is None or not np.all(np.isfinite(x)):
+            x = self._solve_qp(p, q, G=g, h=g_h, A=a_eq, b=b_eq, solver=self.solver, **options)
         if x is None or not np.all(np.isfinite(x)):
             zero = np.zeros(n)
             return QPSolution(False, zero[lay.qacc], zero[lay.tau], np.zeros((nc, 3)), zero)
