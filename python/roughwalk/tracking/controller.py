@@ -112,7 +112,9 @@ class ControlTick:
     qp_forces:
         (4, 3) contact forces the QP chose [N] (zero for feet not in stance).
     solve_time_s:
-        Wall time [s] of building and solving the QP.
+        Wall time [s] of the whole tick (state, tasks, QP).
+    cpu_time_s:
+        CPU time [s] of the tick (its thread's; load-independent, unlike the wall time).
     """
 
     state: MeasuredState
@@ -122,6 +124,7 @@ class ControlTick:
     torques: NDArray[np.float64]
     qp_forces: NDArray[np.float64]
     solve_time_s: float
+    cpu_time_s: float = 0.0
 
 
 class WholeBodyController:
@@ -178,6 +181,7 @@ class WholeBodyController:
     def step(self, t: float) -> ControlTick:
         """Read the state, solve the QP for reference time ``t`` [s], set the torques."""
         started = time.perf_counter()
+        started_cpu = time.thread_time()
         world = self.world
         m, d = world.model, world.data
         # mj_step leaves positions one physics step ahead of the kinematics it
@@ -233,6 +237,7 @@ class WholeBodyController:
             self.torques.copy(),
             qp_forces,
             time.perf_counter() - started,
+            time.thread_time() - started_cpu,
         )
 
     def _swing_for(

@@ -104,7 +104,10 @@ class TrackingOutcome:
     early_touchdowns, late_touchdowns, slips:
         Events of the contact state machine.
     mean_qp_time_ms:
-        Mean wall time [ms] of one control tick's QP (build + solve).
+        Mean wall time [ms] of one control tick (state, tasks, QP build and
+        solve); it follows the machine's load.
+    mean_tick_cpu_ms:
+        Mean CPU time [ms] of one control tick (400 Hz leaves 2.5 ms).
     log:
         Per-tick arrays (not in :meth:`to_dict`).
     """
@@ -125,6 +128,7 @@ class TrackingOutcome:
     late_touchdowns: int
     slips: int
     mean_qp_time_ms: float
+    mean_tick_cpu_ms: float = 0.0
     log: TrackingLog | None = field(default=None, repr=False)
     video: str | None = None
 

@@ -107,39 +107,35 @@ class LegReach:
         local = (centres - sample.base_pos) @ sample.base_rot
         return self.distance(local) - self.max_reach
 
-    def base_drop(self, sample: ReferenceSample, legs: ArrayLike, limit: float = 0.2) -> float:
-        """Smallest lowering dz ≥ 0 [m] of the base that brings ``legs`` (4,) bool within reach.
+    def base_drops(
+        self, samples: list[ReferenceSample], legs: ArrayLike, limit: float = 0.2
+    ) -> NDArray[np.float64]:
+        """Smallest lowering dz ≥ 0 [m] of each sample's base that brings its ``legs`` within reach.
 
-        Bisection on dz (each leg's distance falls monotonically while the foot
-        is below its hip); capped at ``limit`` [m].
+        ``legs`` is (n, 4) bool; returns (n,), capped at ``limit`` [m]. Bisection
+        on dz for all samples at once (each leg's distance falls monotonically
+        while the foot is below its hip).
         """
         use = np.asarray(legs, dtype=bool)
-        if not use.any():
-            return 0.0
-        centres = sample.feet_pos[use] + np.array([0.0, 0.0, self.foot_radius])
-        rot = sample.base_rot
+        centres = np.array([s.feet_pos for s in samples]) + np.array([0.0, 0.0, self.foot_radius])
+        base = np.array([s.base_pos for s in samples])
+        rot = np.array([s.base_rot for s in samples])
 
-        def worst(dz: float) -> float:
-            base = sample.base_pos - np.array([0.0, 0.0, dz])
-            local = (centres - base) @ rot
-            v = local - self.haa[use]
-            rho2 = v[:, 1] ** 2 + v[:, 2] ** 2
-            h2 = np.maximum(rho2 - self.lateral[use] ** 2, 0.0)
-            r = np.sqrt((v[:, 0] - self.hfe_x[use]) ** 2 + h2)
-            return float((r - self.max_reach[use]).max())
+        def worst(dz: NDArray[np.float64]) -> NDArray[np.float64]:
+            rel = centres - (base - dz[:, None] * np.array([0.0, 0.0, 1.0]))[:, None, :]
+            local = np.einsum("nlj,nji->nli", rel, rot)
+            excess = self.distance(local) - self.max_reach
+            return np.asarray(np.where(use, excess, -np.inf).max(axis=1))
 
-        if worst(0.0) <= 0.0:
-            return 0.0
-        if worst(limit) > 0.0:
-            return limit
-        lo, hi = 0.0, limit
+        n = len(samples)
+        lo, hi = np.zeros(n), np.full(n, limit)
+        need = worst(lo) > 0.0
         for _ in range(30):
             mid = 0.5 * (lo + hi)
-            if worst(mid) > 0.0:
-                lo = mid
-            else:
-                hi = mid
-        return hi
+            out = worst(mid) > 0.0
+            lo = np.where(out, mid, lo)
+            hi = np.where(out, hi, mid)
+        return np.where(need, hi, 0.0)
 
 
 def _windowed(values: NDArray[np.float64], half: int, op: str) -> NDArray[np.float64]:
@@ -181,9 +177,7 @@ def reach_aware_reference(
     half = max(1, round(smoothing_s * rate_hz))
     # A swing foot about to bear load needs the reach too (and one just lifted is harmless).
     soon = _windowed(contact.astype(float), half, "max") > 0
-    need = np.array(
-        [reach.base_drop(s, legs, limit_m) for s, legs in zip(samples, soon, strict=True)]
-    )
+    need = reach.base_drops(samples, soon, limit_m)
     if not need.any():
         return reference, times, np.zeros(n)
     drop = _windowed(_windowed(need, half, "max"), half, "mean")

@@ -174,13 +174,21 @@ class Reference:
         offset = np.asarray(result.body.com_in_base if result.body else (0.0, 0.0, 0.0))
         bounds = [schedule.phase_times(i) for i in range(4)]
 
-        def progress(foot: int, t: float) -> tuple[float, float]:
-            """(fraction of the current swing elapsed, its end [s]); (0, NaN) in stance."""
+        stance_phase = [
+            np.array([schedule.is_stance(i, k) for k in range(len(bounds[i]) - 1)])
+            for i in range(4)
+        ]
+
+        def progress(foot: int, t: NDArray[np.float64]) -> NDArray[np.float64]:
+            """(len(t), 2): swing fraction elapsed and the swing's end [s]; (0, NaN) in stance."""
             b = bounds[foot]
-            k = int(np.clip(np.searchsorted(b, t, side="left") - 1, 0, len(b) - 2))
-            if schedule.is_stance(foot, k):
-                return 0.0, math.nan
-            return float((t - b[k]) / max(b[k + 1] - b[k], 1e-9)), float(b[k + 1])
+            k = np.clip(np.searchsorted(b, t, side="left") - 1, 0, len(b) - 2)
+            span = np.maximum(b[k + 1] - b[k], 1e-9)
+            swing = ~stance_phase[foot][k]
+            return np.stack(
+                [np.where(swing, (t - b[k]) / span, 0.0), np.where(swing, b[k + 1], np.nan)],
+                axis=1,
+            )
 
         def sample_many(times: NDArray[np.float64]) -> list[ReferenceSample]:
             lin = splines.base_linear.evaluate(times)
@@ -188,6 +196,7 @@ class Reference:
             feet = [f.evaluate(times) for f in splines.feet]
             forces = np.stack([f.evaluate(times)[0] for f in splines.forces], axis=1)
             contact = np.stack([schedule.in_contact(i, times) for i in range(4)], axis=1)
+            swings_all = np.stack([progress(i, times) for i in range(4)], axis=1)
             out = []
             for j, t in enumerate(times):
                 com, com_vel, com_acc = lin[0][j], lin[1][j], lin[2][j]
@@ -197,7 +206,7 @@ class Reference:
                 alpha = np.asarray(angular_acceleration(euler, rates, euler_acc))
                 r = rot @ offset
                 w_r = _cross(omega, r)
-                swings = np.array([progress(i, float(t)) for i in range(4)])
+                swings = swings_all[j]
                 out.append(
                     ReferenceSample(
                         t=float(t),

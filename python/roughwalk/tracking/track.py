@@ -184,6 +184,7 @@ def _simulate(
     fell_at: float | None = None
     reason = ""
     qp_time = 0.0
+    cpu_time = 0.0
     for k in range(n_ticks):
         t = k * dt
         tick = controller.step(t)
@@ -193,6 +194,7 @@ def _simulate(
             (reference(t) if controller.reference is not reference else tick.reference),
         )
         qp_time += tick.solve_time_s
+        cpu_time += tick.cpu_time_s
         rows["t"].append(t)
         rows["base_pos"].append(s.base_pos)
         rows["base_pos_ref"].append(ref.base_pos)
@@ -257,5 +259,6 @@ def _simulate(
         late_touchdowns=counts["late_touchdown"],
         slips=counts["slip"],
         mean_qp_time_ms=1000.0 * qp_time / max(len(log.t), 1),
+        mean_tick_cpu_ms=1000.0 * cpu_time / max(len(log.t), 1),
         log=log,
     )

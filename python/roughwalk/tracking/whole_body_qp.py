@@ -13,6 +13,7 @@ tick instead of one per priority level).
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -60,6 +61,14 @@ def friction_pyramid(normal: ArrayLike, friction: float) -> NDArray[np.float64]:
     t1 /= np.linalg.norm(t1)
     t2 = np.cross(n, t1)
     return np.array([t1 - friction * n, -t1 - friction * n, t2 - friction * n, -t2 - friction * n])
+
+
+@functools.lru_cache(maxsize=16)
+def _upright_pyramid(friction: float) -> NDArray[np.float64]:
+    """The pyramid of a z-up normal (the default), built once per μ."""
+    rows = friction_pyramid((0.0, 0.0, 1.0), friction)
+    rows.setflags(write=False)
+    return rows
 
 
 class WholeBodyQP:
@@ -179,7 +188,11 @@ class WholeBodyQP:
         for i in range(nc):
             normal = nrm[i] / np.linalg.norm(nrm[i])
             rows = np.zeros((6, n))
-            rows[:4, lay.force(i)] = friction_pyramid(normal, float(mu[i]))
+            rows[:4, lay.force(i)] = (
+                _upright_pyramid(float(mu[i]))
+                if normals is None
+                else friction_pyramid(normal, float(mu[i]))
+            )
             rows[4, lay.force(i)] = -normal
             rows[5, lay.force(i)] = normal
             g_rows.append(rows)
@@ -192,13 +205,12 @@ class WholeBodyQP:
             keep = np.isfinite(g_h)
             g, g_h = g[keep], g_h[keep]
 
-        p = np.zeros((n, n))
-        q = np.zeros(n)
-        for task in tasks:
-            aw = task.weight * task.matrix
-            p += aw.T @ task.matrix
-            q -= aw.T @ task.target
-        p = 0.5 * (p + p.T) + 1e-9 * np.eye(n)
+        # Σ w‖A x − b‖² = ‖Ā x − b̄‖² with rows scaled by √w: one product, not one per task.
+        roots = [np.sqrt(task.weight) for task in tasks]
+        a_all = np.vstack([r * task.matrix for r, task in zip(roots, tasks, strict=True)])
+        b_all = np.concatenate([r * task.target for r, task in zip(roots, tasks, strict=True)])
+        p = a_all.T @ a_all + 1e-9 * np.eye(n)
+        q = -(a_all.T @ b_all)
         options = _solver_options(self.solver)
         x = None
         if qacc_bounds is not None:
