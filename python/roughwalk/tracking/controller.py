@@ -6,6 +6,15 @@ MuJoCo's floating-base quantities: the mass matrix (``mj_fullM``), the bias
 forces (``qfrc_bias`` less the passive joint forces) and the feet's point
 Jacobians and their time derivatives (``mj_jac``, ``mj_jacDot``).
 
+Beyond the plan. The optimiser's motion is not always the robot's: its
+range-of-motion box reaches past ANYmal C's legs and its terrain is smoothed.
+So the tracked base is lowered where planned stance feet are out of reach
+(:mod:`roughwalk.tracking.reach`, applied by :func:`roughwalk.track`), the
+knees and HAA joints are kept in range by bounds on q̈ (a stretched leg must
+not snap through to the other knee branch), and swing feet follow the
+controller's own rise-move-descend paths over the real terrain to footholds
+moved off step edges (:mod:`roughwalk.tracking.swing`).
+
 Torque actuation. ANYmal C's MJCF, like the World it is loaded into, drives
 its joints with position servos (``<position kp=...>``). A whole-body
 controller commands torques, so :func:`tracking_world` turns each leg
