@@ -147,7 +147,7 @@ def run_job(job: Job) -> dict[str, Any]:
             Task(job.start, job.goal),
             config=config,
             init=job.init,
-            solver__max_iter=max(job.max_iter, 0),
+            max_iter=max(job.max_iter, 0),
         )
     except Exception as e:  # noqa: BLE001  (a failed solve is a data point, not a crash)
         row.update(success=False, reason=f"solve raised {type(e).__name__}: {e}")
@@ -173,6 +173,7 @@ def run_job(job: Job) -> dict[str, Any]:
         final_position_error_m=outcome.final_position_error_m,
         max_orientation_error_rad=outcome.max_orientation_error_rad,
         fell=outcome.fell,
+        tick_cpu_ms=outcome.mean_tick_cpu_ms,
         time_s=time.perf_counter() - started,
     )
     return row
@@ -195,6 +196,7 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     out = []
     for (env, init, opt, it), rs in sorted(groups.items(), key=lambda kv: str(kv[0])):
         errors = [r["mean_position_error_m"] for r in rs if "mean_position_error_m" in r]
+        ticks = [r["tick_cpu_ms"] for r in rs if "tick_cpu_ms" in r]
         out.append(
             {
                 "env": env,
@@ -204,6 +206,7 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 "tasks": len(rs),
                 "success_rate": sum(bool(r.get("success")) for r in rs) / len(rs),
                 "mean_tracking_error_m": sum(errors) / len(errors) if errors else None,
+                "mean_tick_cpu_ms": sum(ticks) / len(ticks) if ticks else None,
                 "solved_rate": sum(r.get("solve_status") in ("exact", "acceptable") for r in rs)
                 / len(rs),
             }
@@ -215,15 +218,17 @@ def print_table(summary: list[dict[str, Any]]) -> None:
     """The Figure 8 table."""
     print(
         f"{'env':15s} {'init':10s} {'durations':9s} {'iters':>5s} {'tasks':>5s} "
-        f"{'success':>8s} {'tracking err':>12s}"
+        f"{'success':>8s} {'tracking err':>12s} {'tick CPU':>9s}"
     )
     for s in summary:
         err = s["mean_tracking_error_m"]
+        tick = s["mean_tick_cpu_ms"]
         kind = "optimised" if s["optimize_durations"] else "fixed"
         print(
             f"{s['env']:15s} {s['init']:10s} {kind:9s}"
             f" {s['max_iter']:5d} {s['tasks']:5d} {100 * s['success_rate']:7.0f}% "
             f"{'—' if err is None else f'{100 * err:9.1f} cm':>12s}"
+            f"{'—' if tick is None else f'{tick:6.2f} ms':>10s}"
         )
 
 

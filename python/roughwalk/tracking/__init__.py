@@ -14,7 +14,9 @@ from roughwalk.tracking.config import (
 )
 from roughwalk.tracking.contact_state import ContactEstimate, ContactStateMachine, LegContact
 from roughwalk.tracking.outcome import TrackingLog, TrackingOutcome
+from roughwalk.tracking.reach import LegReach, reach_aware_reference
 from roughwalk.tracking.reference import Reference, ReferenceSample, load_trajectory
+from roughwalk.tracking.swing import SwingPlanner, SwingTrajectory
 from roughwalk.tracking.tasks import LeastSquaresTask, QPLayout
 from roughwalk.tracking.track import TrunkPush, execute_reference, track
 from roughwalk.tracking.whole_body_qp import QPSolution, WholeBodyQP, friction_pyramid
@@ -35,6 +37,10 @@ __all__ = [
     "Reference",
     "ReferenceSample",
     "load_trajectory",
+    "LegReach",
+    "reach_aware_reference",
+    "SwingPlanner",
+    "SwingTrajectory",
     "LeastSquaresTask",
     "QPLayout",
     "WholeBodyQP",

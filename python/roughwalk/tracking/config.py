@@ -199,6 +199,32 @@ class TrackingConfig:
         Track the planned centre of mass with the whole robot's (the single
         rigid body's linear dynamics hold for it exactly) instead of the
         trunk's position.
+    reach_aware:
+        Lower the planned base where the planned stance feet are beyond the
+        legs' reach (:mod:`roughwalk.tracking.reach`); success and tracking
+        errors are still judged against the plan itself.
+    reach_smoothing_s:
+        Window [s] over which that lowering is widened and smoothed: longer
+        is gentler, shorter keeps closer to the plan.
+    min_knee_bend_rad, max_knee_bend_rad:
+        Knee bend [rad] (0 = straight) the controller keeps: the least also
+        sets the reach above; the knee limits and the HAA limits become
+        bounds on q̈ so a stretched leg cannot snap through to the other
+        knee branch.
+    joint_limit_horizon_s:
+        Horizon h [s] of those bounds: q + q̇h + ½q̈h² stays in range. Shorter
+        brakes later and harder.
+    terrain_swings:
+        Swing the feet along the controller's own terrain-clearing paths to
+        edge-safe footholds (:mod:`roughwalk.tracking.swing`) instead of
+        along the planned swing splines, which were planned over a smoothed
+        terrain.
+    swing_clearance_m:
+        Height [m] a swinging foot keeps above the highest terrain between
+        lift-off and touchdown.
+    touchdown_depth_m:
+        A swing aims this far [m] below the ground, so the foot touches down
+        by the planned time instead of hovering.
     """
 
     control_hz: float = 400.0
@@ -212,6 +238,14 @@ class TrackingConfig:
     qp_solver: str = "proxqp"
     track_com: bool = False
     hard_contacts: bool = True
+    reach_aware: bool = True
+    reach_smoothing_s: float = 0.15
+    min_knee_bend_rad: float = 0.35
+    max_knee_bend_rad: float = 2.4
+    joint_limit_horizon_s: float = 0.05
+    terrain_swings: bool = True
+    swing_clearance_m: float = 0.08
+    touchdown_depth_m: float = 0.01
     gains: TrackingGains = field(default_factory=TrackingGains)
     weights: TaskWeights = field(default_factory=TaskWeights)
     contact: ContactStateConfig = field(default_factory=ContactStateConfig)
@@ -226,9 +260,22 @@ class TrackingConfig:
                 "final_position_tolerance_m",
                 "friction",
                 "max_normal_force_n",
+                "reach_smoothing_s",
+                "max_knee_bend_rad",
+                "joint_limit_horizon_s",
+                "swing_clearance_m",
             ),
             "tracking",
         )
+        if not self.touchdown_depth_m >= 0:
+            raise ConfigError(
+                f"tracking.touchdown_depth_m must be ≥ 0, got {self.touchdown_depth_m}"
+            )
+        if not 0 <= self.min_knee_bend_rad < self.max_knee_bend_rad:
+            raise ConfigError(
+                "tracking.min_knee_bend_rad must be ≥ 0 and below max_knee_bend_rad, got "
+                f"{self.min_knee_bend_rad}, {self.max_knee_bend_rad}"
+            )
         if not (self.stand_after_s >= 0 and self.min_normal_force_n >= 0):
             raise ConfigError(
                 "tracking.stand_after_s and tracking.min_normal_force_n must be ≥ 0, got "

@@ -6,6 +6,15 @@ MuJoCo's floating-base quantities: the mass matrix (``mj_fullM``), the bias
 forces (``qfrc_bias`` less the passive joint forces) and the feet's point
 Jacobians and their time derivatives (``mj_jac``, ``mj_jacDot``).
 
+Beyond the plan. The optimiser's motion is not always the robot's: its
+range-of-motion box reaches past ANYmal C's legs and its terrain is smoothed.
+So the tracked base is lowered where planned stance feet are out of reach
+(:mod:`roughwalk.tracking.reach`, applied by :func:`roughwalk.track`), the
+knees and HAA joints are kept in range by bounds on q̈ (a stretched leg must
+not snap through to the other knee branch), and swing feet follow the
+controller's own rise-move-descend paths over the real terrain to footholds
+moved off step edges (:mod:`roughwalk.tracking.swing`).
+
 Torque actuation. ANYmal C's MJCF, like the World it is loaded into, drives
 its joints with position servos (``<position kp=...>``). A whole-body
 controller commands torques, so :func:`tracking_world` turns each leg
@@ -31,6 +40,8 @@ from roughwalk.sim.measured_state import MeasuredState, measure
 from roughwalk.sim.world import World
 from roughwalk.tracking.config import TrackingConfig
 from roughwalk.tracking.contact_state import ContactEstimate, ContactStateMachine, LegContact
+from roughwalk.tracking.reach import LegReach
+from roughwalk.tracking.swing import SwingPlanner, SwingTrajectory
 from roughwalk.tracking.tasks import LeastSquaresTask, force_task, motion_task, regularisation
 from roughwalk.tracking.whole_body_qp import QPSolution, WholeBodyQP
 
@@ -110,7 +121,9 @@ class ControlTick:
     qp_forces:
         (4, 3) contact forces the QP chose [N] (zero for feet not in stance).
     solve_time_s:
-        Wall time [s] of building and solving the QP.
+        Wall time [s] of the whole tick (state, tasks, QP).
+    cpu_time_s:
+        CPU time [s] of the tick (its thread's; load-independent, unlike the wall time).
     """
 
     state: MeasuredState
@@ -120,6 +133,7 @@ class ControlTick:
     torques: NDArray[np.float64]
     qp_forces: NDArray[np.float64]
     solve_time_s: float
+    cpu_time_s: float = 0.0
 
 
 class WholeBodyController:
@@ -161,12 +175,22 @@ class WholeBodyController:
         self._jacp = np.zeros((3, self.nv))
         self._jacdot = np.zeros((3, self.nv))
         self._scratch = mujoco.MjData(m)
+        reach = LegReach(world.robot, cfg.min_knee_bend_rad)
+        lower, upper = reach.joint_range(cfg.min_knee_bend_rad, cfg.max_knee_bend_rad)
+        self._joint_lower, self._joint_upper = lower, upper
+        self.swing_planner = (
+            SwingPlanner(world.terrain, self.foot_radius, cfg.swing_clearance_m)
+            if cfg.terrain_swings
+            else None
+        )
+        self._swings: list[SwingTrajectory | None] = [None] * 4
 
     # ---- one tick -------------------------------------------------------------------
 
     def step(self, t: float) -> ControlTick:
         """Read the state, solve the QP for reference time ``t`` [s], set the torques."""
         started = time.perf_counter()
+        started_cpu = time.thread_time()
         world = self.world
         m, d = world.model, world.data
         # mj_step leaves positions one physics step ahead of the kinematics it
@@ -198,7 +222,15 @@ class WholeBodyController:
             np.where(estimate.slipping[stance], self.config.gains.slip_friction_scale, 1.0)
             * self.config.friction
         )
-        solution = self.qp.solve(self._mass, h, jc, tasks, contact_bias=hard, friction=friction)
+        solution = self.qp.solve(
+            self._mass,
+            h,
+            jc,
+            tasks,
+            contact_bias=hard,
+            friction=friction,
+            qacc_bounds=self._qacc_bounds(),
+        )
         qp_forces = np.zeros((4, 3))
         if solution.success:
             self.torques = solution.tau
@@ -214,7 +246,44 @@ class WholeBodyController:
             self.torques.copy(),
             qp_forces,
             time.perf_counter() - started,
+            time.thread_time() - started_cpu,
         )
+
+    def _swing_for(
+        self,
+        leg: int,
+        ref: ReferenceSample,
+        foot: NDArray[np.float64],
+        shift: NDArray[np.float64],
+    ) -> SwingTrajectory | None:
+        """The leg's own swing (made at lift-off), or None to follow the planned splines."""
+        if self.swing_planner is None or ref.swing_end is None:
+            return None
+        end = float(ref.swing_end[leg])
+        current = self._swings[leg]
+        if not np.isfinite(end):
+            # Planned stance: a late foot keeps the swing it had.
+            return current
+        if current is None or current.t1 != end:
+            planned = self.reference(end).feet_pos[leg] + shift
+            target = self.swing_planner.foothold(planned)
+            target[2] -= self.config.touchdown_depth_m
+            current = self.swing_planner.swing(foot, target, ref.t, end)
+            self._swings[leg] = current
+        return current
+
+    def _qacc_bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """(nv,) q̈ bounds keeping q + q̇h + ½q̈h² within the joints' kept range."""
+        world, d = self.world, self.world.data
+        h = self.config.joint_limit_horizon_s
+        q = d.qpos[world.joint_qpos]
+        ahead = q + d.qvel[world.joint_dof] * h
+        lower = np.full(self.nv, -np.inf)
+        upper = np.full(self.nv, np.inf)
+        with np.errstate(invalid="ignore"):
+            lower[world.joint_dof] = 2.0 * (self._joint_lower - ahead) / (h * h)
+            upper[world.joint_dof] = 2.0 * (self._joint_upper - ahead) / (h * h)
+        return lower, upper
 
     def _com_jacobian(
         self,
@@ -336,12 +405,15 @@ class WholeBodyController:
                 )
                 continue
             target, target_vel, target_acc = ref.feet_pos[leg], ref.feet_vel[leg], ref.feet_acc[leg]
-            if s == LegContact.SWING:
+            swing = self._swing_for(leg, ref, points[leg], shift)
+            if s == LegContact.SWING and swing is not None:
+                target, target_vel, target_acc = swing(ref.t)
+            elif s == LegContact.SWING:
                 blend = float(np.clip(ref.swing_progress[leg], 0.0, 1.0))
                 target = target + blend * shift
             if s == LegContact.LATE_TOUCHDOWN:
                 # Keep reaching down until the ground is found (or too deep).
-                target = target + shift
+                target = swing.target if swing is not None else target + shift
                 depth = min(c.search_speed_m_s * estimate.late_since[leg], c.search_depth_m)
                 target = target - depth * _Z
                 target_vel = -c.search_speed_m_s * _Z if depth < c.search_depth_m else np.zeros(3)

@@ -38,6 +38,8 @@ class TrackingLog:
         (n, 4) planned contact and the contact state machine's stance.
     torques:
         (n, 12) joint torques sent [N·m].
+    shin_contact:
+        (n, 4) a leg link other than the foot touches the terrain.
     qpos:
         (n, nq) MuJoCo ``qpos`` (for videos).
     """
@@ -54,6 +56,7 @@ class TrackingLog:
     contact_ref: NDArray[np.bool_]
     stance: NDArray[np.bool_]
     torques: NDArray[np.float64]
+    shin_contact: NDArray[np.bool_]
     qpos: NDArray[np.float64]
 
     @property
@@ -101,7 +104,10 @@ class TrackingOutcome:
     early_touchdowns, late_touchdowns, slips:
         Events of the contact state machine.
     mean_qp_time_ms:
-        Mean wall time [ms] of one control tick's QP (build + solve).
+        Mean wall time [ms] of one control tick (state, tasks, QP build and
+        solve); it follows the machine's load.
+    mean_tick_cpu_ms:
+        Mean CPU time [ms] of one control tick (400 Hz leaves 2.5 ms).
     log:
         Per-tick arrays (not in :meth:`to_dict`).
     """
@@ -122,6 +128,7 @@ class TrackingOutcome:
     late_touchdowns: int
     slips: int
     mean_qp_time_ms: float
+    mean_tick_cpu_ms: float = 0.0
     log: TrackingLog | None = field(default=None, repr=False)
     video: str | None = None
 

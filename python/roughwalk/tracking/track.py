@@ -22,6 +22,7 @@ from roughwalk.errors import InvalidArgumentError
 from roughwalk.tracking.config import TrackingConfig
 from roughwalk.tracking.controller import WholeBodyController, rotation_error, tracking_world
 from roughwalk.tracking.outcome import TrackingLog, TrackingOutcome
+from roughwalk.tracking.reach import LegReach, reach_aware_reference
 from roughwalk.tracking.reference import Reference, load_trajectory
 from roughwalk.tracking.world_terrain import terrain_covering
 
@@ -107,10 +108,16 @@ def execute_reference(
     samples = [reference(float(t)) for t in span]
     points = np.concatenate([np.vstack([s.feet_pos, s.base_pos[None]]) for s in samples])
     world = tracking_world(robot, terrain_covering(terrain, points), cfg)
-    unreachable = _start(world, reference)
+    reference = reference.tabulated(cfg.control_hz)
+    tracked = reference
+    if cfg.reach_aware:
+        reach = LegReach(robot, cfg.min_knee_bend_rad)
+        tracked, _, _ = reach_aware_reference(reference, reach, smoothing_s=cfg.reach_smoothing_s)
+        tracked = tracked.tabulated(cfg.control_hz)
+    unreachable = _start(world, tracked)
     if unreachable:
         return _not_started(reference, unreachable)
-    controller = WholeBodyController(world, reference, cfg)
+    controller = WholeBodyController(world, tracked, cfg)
     outcome = _simulate(world, controller, reference, cfg, push)
     if video is not None and outcome.log is not None:
         from roughwalk.tracking.video import render_tracking
@@ -177,11 +184,17 @@ def _simulate(
     fell_at: float | None = None
     reason = ""
     qp_time = 0.0
+    cpu_time = 0.0
     for k in range(n_ticks):
         t = k * dt
         tick = controller.step(t)
-        s, ref = tick.state, tick.reference
+        # Judged against the plan, whatever the controller tracks.
+        s, ref = (
+            tick.state,
+            (reference(t) if controller.reference is not reference else tick.reference),
+        )
         qp_time += tick.solve_time_s
+        cpu_time += tick.cpu_time_s
         rows["t"].append(t)
         rows["base_pos"].append(s.base_pos)
         rows["base_pos_ref"].append(ref.base_pos)
@@ -194,6 +207,7 @@ def _simulate(
         rows["contact_ref"].append(ref.contact)
         rows["stance"].append(tick.contact.stance)
         rows["torques"].append(tick.torques)
+        rows["shin_contact"].append(s.shin_contact)
         rows["qpos"].append(d.qpos.copy())
         roll, pitch = s.roll_pitch
         if s.trunk_contact:
@@ -245,5 +259,6 @@ def _simulate(
         late_touchdowns=counts["late_touchdown"],
         slips=counts["slip"],
         mean_qp_time_ms=1000.0 * qp_time / max(len(log.t), 1),
+        mean_tick_cpu_ms=1000.0 * cpu_time / max(len(log.t), 1),
         log=log,
     )

@@ -13,6 +13,7 @@ tick instead of one per priority level).
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -60,6 +61,14 @@ def friction_pyramid(normal: ArrayLike, friction: float) -> NDArray[np.float64]:
     t1 /= np.linalg.norm(t1)
     t2 = np.cross(n, t1)
     return np.array([t1 - friction * n, -t1 - friction * n, t2 - friction * n, -t2 - friction * n])
+
+
+@functools.lru_cache(maxsize=16)
+def _upright_pyramid(friction: float) -> NDArray[np.float64]:
+    """The pyramid of a z-up normal (the default), built once per μ."""
+    rows = friction_pyramid((0.0, 0.0, 1.0), friction)
+    rows.setflags(write=False)
+    return rows
 
 
 class WholeBodyQP:
@@ -121,6 +130,7 @@ class WholeBodyQP:
         normals: ArrayLike | None = None,
         contact_bias: ArrayLike | None = None,
         friction: ArrayLike | None = None,
+        qacc_bounds: tuple[ArrayLike, ArrayLike] | None = None,
     ) -> QPSolution:
         """Minimise Σ w‖A x − b‖² subject to dynamics, friction and torque limits.
 
@@ -141,6 +151,10 @@ class WholeBodyQP:
             J_c q̈ + J̇_c q̇ = 0, as a hard constraint (else it is up to the tasks).
         friction:
             (nc,) μ per stance foot (default: the solver's μ for all).
+        qacc_bounds:
+            (nv,) lower and upper bounds on q̈ (±inf where free): joint limits
+            turned into acceleration bounds by the caller. When they make the
+            QP infeasible it is solved again without them.
         """
         m = np.asarray(mass_matrix, dtype=float)
         h = np.asarray(bias, dtype=float)
@@ -174,7 +188,11 @@ class WholeBodyQP:
         for i in range(nc):
             normal = nrm[i] / np.linalg.norm(nrm[i])
             rows = np.zeros((6, n))
-            rows[:4, lay.force(i)] = friction_pyramid(normal, float(mu[i]))
+            rows[:4, lay.force(i)] = (
+                _upright_pyramid(float(mu[i]))
+                if normals is None
+                else friction_pyramid(normal, float(mu[i]))
+            )
             rows[4, lay.force(i)] = -normal
             rows[5, lay.force(i)] = normal
             g_rows.append(rows)
@@ -187,16 +205,24 @@ class WholeBodyQP:
             keep = np.isfinite(g_h)
             g, g_h = g[keep], g_h[keep]
 
-        p = np.zeros((n, n))
-        q = np.zeros(n)
-        for task in tasks:
-            aw = task.weight * task.matrix
-            p += aw.T @ task.matrix
-            q -= aw.T @ task.target
-        p = 0.5 * (p + p.T) + 1e-9 * np.eye(n)
-        x = self._solve_qp(
-            p, q, G=g, h=g_h, A=a_eq, b=b_eq, solver=self.solver, **_solver_options(self.solver)
-        )
+        # Σ w‖A x − b‖² = ‖Ā x − b̄‖² with rows scaled by √w: one product, not one per task.
+        roots = [np.sqrt(task.weight) for task in tasks]
+        a_all = np.vstack([r * task.matrix for r, task in zip(roots, tasks, strict=True)])
+        b_all = np.concatenate([r * task.target for r, task in zip(roots, tasks, strict=True)])
+        p = a_all.T @ a_all + 1e-9 * np.eye(n)
+        q = -(a_all.T @ b_all)
+        options = _solver_options(self.solver)
+        x = None
+        if qacc_bounds is not None:
+            lb = np.full(n, -np.inf)
+            ub = np.full(n, np.inf)
+            lb[lay.qacc] = qacc_bounds[0]
+            ub[lay.qacc] = qacc_bounds[1]
+            x = self._solve_qp(
+                p, q, G=g, h=g_h, A=a_eq, b=b_eq, lb=lb, ub=ub, solver=self.solver, **options
+            )
+        if x is None or not np.all(np.isfinite(x)):
+            x = self._solve_qp(p, q, G=g, h=g_h, A=a_eq, b=b_eq, solver=self.solver, **options)
         if x is None or not np.all(np.isfinite(x)):
             zero = np.zeros(n)
             return QPSolution(False, zero[lay.qacc], zero[lay.tau], np.zeros((nc, 3)), zero)
