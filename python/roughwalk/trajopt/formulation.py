@@ -81,6 +81,49 @@ def _balanced_sum(terms: list[ca.SX]) -> ca.SX:
     return terms[0]
 
 
+def _chunk_hessians(expr: ca.SX, weights: ca.SX, z: ca.SX, rows_per_block: int) -> list[ca.SX]:
+    """∇²_z (λᵀ g) of every block of rows of ``expr`` that is not linear in z."""
+    blocks = []
+    for start in range(0, int(expr.numel()), rows_per_block):
+        stop = min(start + rows_per_block, int(expr.numel()))
+        chunk = expr[start:stop]
+        # Linear rows (start, goal, apex, most bounds) have no curvature.
+        if any(ca.which_depends(chunk, z, 2, True)):
+            blocks.append(ca.hessian(ca.dot(weights[start:stop], chunk), z)[0])
+    return blocks
+
+
+def _call_hessians(rows: Rows, weights: ca.SX, z: ca.SX) -> list[ca.SX]:
+    """∇²_z (λᵀ g) of rows made of calls: Aᵀ ∇²ᵤ(λᵀ function) A where u = A z + b.
+
+    A call whose inputs are not affine in z (optimised phase durations) gets
+    the generic Hessian of its rows.
+    """
+    local: dict[int, ca.Function] = {}
+    blocks = []
+    start = 0
+    for call in rows.calls or []:
+        fn = call.function
+        n_rows = int(fn.numel_out(0))
+        stop = start + n_rows
+        u = ca.vertcat(*[ca.vec(v) for v in call.inputs])
+        a = ca.jacobian(u, z)
+        if not a.is_constant():
+            blocks.extend(_chunk_hessians(rows.expr[start:stop], weights[start:stop], z, n_rows))
+            start = stop
+            continue
+        if id(fn) not in local:
+            symbols = [ca.SX.sym(f"u{i}", fn.sparsity_in(i)) for i in range(fn.n_in())]
+            flat = ca.vertcat(*[ca.vec(v) for v in symbols])
+            lam = ca.SX.sym("lam", n_rows)
+            hess = ca.hessian(ca.dot(lam, ca.vec(fn(*symbols))), flat)[0]
+            local[id(fn)] = ca.Function(f"{fn.name()}_hessian", [flat, lam], [hess])
+        a_num = ca.DM(a)
+        blocks.append(a_num.T @ local[id(fn)](u, weights[start:stop]) @ a_num)
+        start = stop
+    return blocks
+
+
 class Formulation:
     """The NLP of one (body, contact schedule, duration, terrain, config).
 
@@ -302,14 +345,11 @@ class Formulation:
         blocks = []
         offset = 0
         for rows in self.rows:
-            for start in range(0, rows.size, _ROWS_PER_BLOCK):
-                stop = min(start + _ROWS_PER_BLOCK, rows.size)
-                chunk = rows.expr[start:stop]
-                # Linear rows (start, goal, apex, most bounds) have no curvature.
-                if not any(ca.which_depends(chunk, z, 2, True)):
-                    continue
-                weights = lam_g[offset + start : offset + stop]
-                blocks.append(ca.hessian(ca.dot(weights, chunk), z)[0])
+            weights = lam_g[offset : offset + rows.size]
+            if rows.calls is not None:
+                blocks.extend(_call_hessians(rows, weights, z))
+            else:
+                blocks.extend(_chunk_hessians(rows.expr, weights, z, _ROWS_PER_BLOCK))
             offset += rows.size
         for cost in self.costs:
             blocks.append(lam_f * ca.hessian(ca.SX(cost.expr), z)[0])
