@@ -200,10 +200,15 @@ class SolverOptions:
         Wall-time limit [s] per solve (TOWR's ROS app uses 40 s of CPU time).
     hessian:
         "exact" (second derivatives), "limited-memory" (L-BFGS, as TOWR's
-        ifopt) or "auto": exact when the NLP has costs and fixed phase
-        durations, L-BFGS otherwise. L-BFGS solves TOWR's feasibility problems
-        in fewer, cheaper iterations; with costs it converges slowly, and with
-        optimised durations the exact Hessian is dense and slow to build.
+        ifopt) or "auto": exact when the NLP has costs, L-BFGS otherwise.
+        L-BFGS solves TOWR's feasibility problems in fewer, cheaper
+        iterations (exact: 2–3× the iterations on the block and the gap).
+        With costs it converges slowly or not at all: on flat ground (trot)
+        it stops at the 40 s limit after ~500 iterations where exact takes
+        25, and with optimised
+        durations on the single pallet it leaves the dynamics violated by
+        0.02 after 400 iterations where exact converges in 93, after a
+        build of ~10 s of CPU (the durations make the Hessian dense).
     tol:
         IPOPT's convergence tolerance on the scaled NLP error.
     acceptable_tol:
@@ -307,11 +312,10 @@ class TrajoptConfig:
         Optimise the phase durations (adds one variable per phase and foot
         but the last): more freedom, but every sample may fall in any
         polynomial, which makes the NLP dense — slower iterations and, with
-        costs, slow convergence: with Melon's costs on the single pallet,
-        L-BFGS still leaves the dynamics violated by ~0.6 after 150
-        iterations, and the exact Hessian takes ~25 s of CPU to build. Off
-        by default, as in TOWR; Melon et al. found fixed durations more
-        reliable too (Fig. 8).
+        costs, a costly exact Hessian: on the single pallet with Melon's
+        costs it takes ~10 s of CPU to build and the solve 93 iterations
+        (L-BFGS does not converge there). Off by default, as in TOWR; Melon
+        et al. found fixed durations more reliable too (Fig. 8).
     phase_duration_bounds:
         (min, max) [s] of an optimised phase (TOWR's 0.2–1.0 s).
     body_model:

@@ -247,7 +247,7 @@ class TrajoptSolver:
         fixed = not nlp.config.optimize_durations
         self.hessian = o.hessian
         if o.hessian == "auto":
-            self.hessian = "exact" if nlp.costs and fixed else "limited-memory"
+            self.hessian = "exact" if nlp.costs else "limited-memory"
         pivot_order = o.mumps_pivot_order
         if pivot_order is None:
             pivot_order = 7 if fixed else 5
