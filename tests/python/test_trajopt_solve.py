@@ -465,3 +465,14 @@ def test_mumps_scaling_follows_the_hessian_unless_set(tmp_path: Path) -> None:
         tmp_path, "kept", solver__hessian="exact", solver__mumps_scaling=True
     )
     assert "mumps_scaling" not in kept
+
+
+def test_mumps_ordering_follows_durations_and_hessian(tmp_path: Path) -> None:
+    fixed = _ipopt_user_options(tmp_path, "fixed", solver__hessian="exact")
+    assert fixed["mumps_pivot_order"] == "7"
+    metis = _ipopt_user_options(
+        tmp_path, "metis", solver__hessian="limited-memory", optimize_durations=True
+    )
+    assert metis["mumps_pivot_order"] == "5"
+    amd = _ipopt_user_options(tmp_path, "amd", solver__hessian="exact", optimize_durations=True)
+    assert amd["mumps_pivot_order"] == "0"

@@ -250,7 +250,7 @@ class TrajoptSolver:
             self.hessian = "exact" if nlp.costs else "limited-memory"
         pivot_order = o.mumps_pivot_order
         if pivot_order is None:
-            pivot_order = 7 if fixed else 5
+            pivot_order = 7 if fixed else (0 if self.hessian == "exact" else 5)
         scaling = o.mumps_scaling
         if scaling is None:
             scaling = self.hessian != "exact"
