@@ -240,3 +240,32 @@ def test_terrain_gradient_and_edges() -> None:
     pallet = TerrainModel(load_terrain("single_pallet"))
     cost = pallet.edge_cost([[1.0, 0.0], [1.05, 0.0], [1.6, 0.0], [0.0, 0.0]])
     assert cost[0] > 0.9 and cost[1] < cost[0] and cost[2] < 1e-3 and cost[3] < 1e-3
+
+
+@pytest.mark.parametrize("optimize_durations", [False, True])
+def test_hessian_equals_casadis_of_the_whole_lagrangian(optimize_durations: bool) -> None:
+    # The dynamics and range-of-motion rows are mapped from their functions' own
+    # small Hessians (Aᵀ ∇²ᵤ A); with optimised durations their inputs are not
+    # affine and they fall back to the rows' Hessian. Both must equal CasADi's
+    # Hessian of the Lagrangian as one MX expression, terrain splines included.
+    config = melon_config(duration=2.0, steps=4, optimize_durations=optimize_durations)
+    terrain = TerrainModel(
+        load_terrain("single_pallet"), config.terrain, config.costs.step_edge_sigma
+    )
+    nlp = Formulation(config, TOWR_ANYMAL, make_gait("walk", 4, 2.0), terrain)
+    assert any(rows.calls for rows in nlp.rows)
+    task = resolve(Task((0.55, 0.0, 0.0), (0.95, 0.05, 0.1)), TOWR_ANYMAL, terrain)
+    rng = np.random.default_rng(7)
+    x = HeuristicInitializer().guess(nlp, task) + 0.01 * rng.normal(size=nlp.n_variables)
+    p = task.vector()
+    lam_g = rng.normal(size=nlp.n_constraints)
+    x_mx, p_mx = nlp.nlp["x"], nlp.nlp["p"]
+    lam_f_mx, lam_g_mx = ca.MX.sym("lam_f"), ca.MX.sym("lam_g", nlp.n_constraints)
+    lagrangian = lam_f_mx * nlp.nlp["f"] + ca.dot(lam_g_mx, nlp.nlp["g"])
+    reference = ca.Function(
+        "reference", [x_mx, p_mx, lam_f_mx, lam_g_mx], [ca.triu(ca.hessian(lagrangian, x_mx)[0])]
+    )
+    expected = np.asarray(ca.densify(reference(x, p, 0.7, lam_g)))
+    hess = np.asarray(ca.densify(nlp.hess_lag(x, p, 0.7, lam_g)))
+    assert np.max(np.abs(expected)) > 100.0
+    np.testing.assert_allclose(hess, expected, rtol=0, atol=1e-9 * np.max(np.abs(expected)))

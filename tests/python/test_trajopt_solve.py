@@ -421,3 +421,58 @@ def test_mumps_runs_on_one_blas_thread_and_orderings_are_checked() -> None:
         solver__mumps_pivot_order=0,
     )
     assert result.solved, result.message
+
+
+def _ipopt_user_options(tmp_path: Path, name: str, **overrides: object) -> dict[str, str]:
+    """The options IPOPT itself reports as set by the user, for one short solve."""
+    log = tmp_path / f"{name}.txt"
+    optimize_motion(
+        None,
+        "flat",
+        ((0.0, 0.0, 0.0), (0.8, 0.0, 0.0)),
+        config=towr_config(),
+        gait="walk",
+        steps=8,
+        duration=3.0,
+        max_iter=1,
+        solver__ipopt_options=(
+            f"output_file={log}",
+            "file_print_level=5",
+            "print_user_options=yes",
+        ),
+        **overrides,
+    )
+    options = {}
+    for line in log.read_text().splitlines():
+        parts = line.split()
+        if len(parts) == 4 and parts[1] == "=" and parts[3] in ("yes", "no"):
+            options[parts[0]] = parts[2]
+    return options
+
+
+def test_mumps_scaling_follows_the_hessian_unless_set(tmp_path: Path) -> None:
+    exact = _ipopt_user_options(tmp_path, "exact", solver__hessian="exact")
+    assert exact["hessian_approximation"] == "exact"
+    assert exact["mumps_scaling"] == "0" and exact["mumps_permuting_scaling"] == "0"
+    lbfgs = _ipopt_user_options(tmp_path, "lbfgs", solver__hessian="limited-memory")
+    assert lbfgs["hessian_approximation"] == "limited-memory"
+    assert "mumps_scaling" not in lbfgs and "mumps_permuting_scaling" not in lbfgs
+    forced = _ipopt_user_options(
+        tmp_path, "forced", solver__hessian="limited-memory", solver__mumps_scaling=False
+    )
+    assert forced["mumps_scaling"] == "0"
+    kept = _ipopt_user_options(
+        tmp_path, "kept", solver__hessian="exact", solver__mumps_scaling=True
+    )
+    assert "mumps_scaling" not in kept
+
+
+def test_mumps_ordering_follows_durations_and_hessian(tmp_path: Path) -> None:
+    fixed = _ipopt_user_options(tmp_path, "fixed", solver__hessian="exact")
+    assert fixed["mumps_pivot_order"] == "7"
+    metis = _ipopt_user_options(
+        tmp_path, "metis", solver__hessian="limited-memory", optimize_durations=True
+    )
+    assert metis["mumps_pivot_order"] == "5"
+    amd = _ipopt_user_options(tmp_path, "amd", solver__hessian="exact", optimize_durations=True)
+    assert amd["mumps_pivot_order"] == "0"

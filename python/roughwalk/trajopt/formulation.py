@@ -81,6 +81,54 @@ def _balanced_sum(terms: list[ca.SX]) -> ca.SX:
     return terms[0]
 
 
+def _chunk_hessians(expr: ca.SX, weights: ca.SX, z: ca.SX, rows_per_block: int) -> list[ca.SX]:
+    """∇²_z (λᵀ g) of every block of rows of ``expr`` that is not linear in z."""
+    blocks = []
+    for start in range(0, int(expr.numel()), rows_per_block):
+        stop = min(start + rows_per_block, int(expr.numel()))
+        chunk = expr[start:stop]
+        # Linear rows (start, goal, apex, most bounds) have no curvature.
+        if any(ca.which_depends(chunk, z, 2, True)):
+            blocks.append(ca.hessian(ca.dot(weights[start:stop], chunk), z)[0])
+    return blocks
+
+
+def _call_hessians(rows: Rows, weights: ca.SX, z: ca.SX) -> list[ca.SX]:
+    """∇²_z (λᵀ g) of rows made of calls g = F(u(z)), by the chain rule.
+
+    ∇²_z = Jᵀ ∇²ᵤ(λᵀF) J + Σⱼ μⱼ ∇²_z uⱼ with J = ∂u/∂z and μ = ∇ᵤ(λᵀF):
+    F's own small Hessian, mapped, plus the curvature of the spline points
+    u, which is zero when they are affine in z (fixed durations) and
+    otherwise a far smaller graph to differentiate twice than F∘u.
+    """
+    local: dict[int, ca.Function] = {}
+    blocks = []
+    start = 0
+    for call in rows.calls or []:
+        fn = call.function
+        n_rows = int(fn.numel_out(0))
+        stop = start + n_rows
+        if id(fn) not in local:
+            symbols = [ca.SX.sym(f"u{i}", fn.sparsity_in(i)) for i in range(fn.n_in())]
+            flat = ca.vertcat(*[ca.vec(v) for v in symbols])
+            lam = ca.SX.sym("lam", n_rows)
+            hess, grad = ca.hessian(ca.dot(lam, ca.vec(fn(*symbols))), flat)
+            local[id(fn)] = ca.Function(f"{fn.name()}_hessian", [flat, lam], [hess, grad])
+        u = ca.vertcat(*[ca.vec(v) for v in call.inputs])
+        h_u, mu = local[id(fn)](u, weights[start:stop])
+        jac = ca.jacobian(u, z)
+        if jac.is_constant():
+            a = ca.DM(jac)
+            blocks.append(a.T @ h_u @ a)
+        else:
+            blocks.append(jac.T @ h_u @ jac)
+            m = ca.SX.sym("mu", u.numel())
+            curvature = ca.hessian(ca.dot(m, u), z)[0]
+            blocks.append(ca.substitute(curvature, m, mu))
+        start = stop
+    return blocks
+
+
 class Formulation:
     """The NLP of one (body, contact schedule, duration, terrain, config).
 
@@ -302,14 +350,11 @@ class Formulation:
         blocks = []
         offset = 0
         for rows in self.rows:
-            for start in range(0, rows.size, _ROWS_PER_BLOCK):
-                stop = min(start + _ROWS_PER_BLOCK, rows.size)
-                chunk = rows.expr[start:stop]
-                # Linear rows (start, goal, apex, most bounds) have no curvature.
-                if not any(ca.which_depends(chunk, z, 2, True)):
-                    continue
-                weights = lam_g[offset + start : offset + stop]
-                blocks.append(ca.hessian(ca.dot(weights, chunk), z)[0])
+            weights = lam_g[offset : offset + rows.size]
+            if rows.calls is not None:
+                blocks.extend(_call_hessians(rows, weights, z))
+            else:
+                blocks.extend(_chunk_hessians(rows.expr, weights, z, _ROWS_PER_BLOCK))
             offset += rows.size
         for cost in self.costs:
             blocks.append(lam_f * ca.hessian(ca.SX(cost.expr), z)[0])

@@ -247,10 +247,16 @@ class TrajoptSolver:
         fixed = not nlp.config.optimize_durations
         self.hessian = o.hessian
         if o.hessian == "auto":
-            self.hessian = "exact" if nlp.costs and fixed else "limited-memory"
+            self.hessian = "exact" if nlp.costs else "limited-memory"
         pivot_order = o.mumps_pivot_order
         if pivot_order is None:
-            pivot_order = 7 if fixed else 5
+            pivot_order = 7 if fixed else (0 if self.hessian == "exact" else 5)
+        scaling = o.mumps_scaling
+        if scaling is None:
+            scaling = self.hessian != "exact"
+        mumps: dict[str, Any] = {"mumps_pivot_order": pivot_order}
+        if not scaling:
+            mumps.update(mumps_scaling=0, mumps_permuting_scaling=0)
         self._monitor = _Monitor(
             nlp.n_variables, nlp.n_constraints, int(nlp.p.numel()), nlp.lbg, nlp.ubg
         )
@@ -262,7 +268,7 @@ class TrajoptSolver:
             "constr_viol_tol": o.constr_viol_tol,
             "linear_solver": o.linear_solver,
             "hessian_approximation": self.hessian,
-            **({"mumps_pivot_order": pivot_order} if o.linear_solver == "mumps" else {}),
+            **(mumps if o.linear_solver == "mumps" else {}),
             # Only a ceiling: each solve's own limit is enforced by the monitor, because
             # IPOPT's options are fixed when the solver is built and a cached solver
             # serves solves with other limits (one built for max_iter=0 stopped every

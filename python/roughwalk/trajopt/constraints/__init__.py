@@ -12,9 +12,24 @@ import pkgutil
 from collections.abc import Callable
 
 from roughwalk.errors import ConfigError
-from roughwalk.trajopt.constraints.constraint import Constraint, Rows, stack_rows
+from roughwalk.trajopt.constraints.constraint import (
+    Call,
+    Constraint,
+    Rows,
+    stack_calls,
+    stack_rows,
+)
 
-__all__ = ["Constraint", "Rows", "stack_rows", "register", "make_constraint", "constraint_names"]
+__all__ = [
+    "Call",
+    "Constraint",
+    "Rows",
+    "stack_rows",
+    "stack_calls",
+    "register",
+    "make_constraint",
+    "constraint_names",
+]
 
 _REGISTRY: dict[str, type[Constraint]] = {}
 _LOADED = False

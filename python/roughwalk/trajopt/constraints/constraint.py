@@ -14,17 +14,37 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from roughwalk.trajopt.formulation import Formulation
 
-__all__ = ["Rows", "Constraint", "stack_rows"]
+__all__ = ["Call", "Rows", "Constraint", "stack_rows", "stack_calls"]
+
+
+@dataclass(frozen=True)
+class Call:
+    """Rows that are one small SX function of a few spline points: ``function(*inputs)``.
+
+    The spline points are affine in the variables when the phase durations
+    are fixed (u = A x + b), so the Hessian of λᵀ function(u) is
+    Aᵀ ∇²ᵤ(λᵀ function) A: the function's own small Hessian, mapped. The
+    formulation builds it that way, in a fraction of the operations of
+    differentiating the inlined expression twice.
+    """
+
+    function: ca.Function
+    inputs: tuple[ca.SX, ...]
 
 
 @dataclass
 class Rows:
-    """Constraint rows lower ≤ expr ≤ upper; ``expr`` is an (n, 1) SX."""
+    """Constraint rows lower ≤ expr ≤ upper; ``expr`` is an (n, 1) SX.
+
+    ``calls``, when given, are the same rows as function calls, in order
+    (see :class:`Call`).
+    """
 
     name: str
     expr: ca.SX
     lower: NDArray[np.float64]
     upper: NDArray[np.float64]
+    calls: list[Call] | None = None
 
     @property
     def size(self) -> int:
@@ -57,3 +77,13 @@ class Constraint(ABC):
     @abstractmethod
     def build(self, nlp: Formulation) -> Rows | None:
         """The rows of this constraint for the problem ``nlp`` (None if it has none)."""
+
+
+def stack_calls(
+    name: str, function: ca.Function, calls: Sequence[tuple[Sequence[ca.SX], Bound, Bound]]
+) -> Rows | None:
+    """Rows ``function(*inputs)`` from (inputs, lower, upper) pieces, keeping the calls."""
+    rows = stack_rows(name, [(function(*inputs), lo, hi) for inputs, lo, hi in calls])
+    if rows is not None:
+        rows.calls = [Call(function, tuple(ca.SX(u) for u in inputs)) for inputs, _, _ in calls]
+    return rows

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import casadi as ca
 
-from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_rows
+from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_calls
 from roughwalk.trajopt.robot_model import GRAVITY, SingleRigidBody
 from roughwalk.trajopt.variables import angular_acceleration, angular_velocity, euler_to_rotation
 
@@ -60,5 +60,5 @@ class Dynamics(Constraint):
             eta, etad, etadd = nlp.base_ang.spline.point(t)
             feet = ca.vertcat(*[m.spline.point(t)[0] for m in nlp.feet])
             forces = ca.vertcat(*[f.spline.point(t)[0] for f in nlp.forces])
-            parts.append((residual(c, cdd, eta, etad, etadd, feet, forces), 0.0, 0.0))
-        return stack_rows(self.name, parts)
+            parts.append(((c, cdd, eta, etad, etadd, feet, forces), 0.0, 0.0))
+        return stack_calls(self.name, residual, parts)

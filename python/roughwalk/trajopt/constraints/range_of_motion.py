@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import casadi as ca
 import numpy as np
 
-from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_rows
+from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_calls
 from roughwalk.trajopt.variables import euler_to_rotation
 
 if TYPE_CHECKING:
@@ -37,10 +37,6 @@ class RangeOfMotion(Constraint):
             angles = nlp.base_ang.spline.point(t)[0]
             for i, motion in enumerate(nlp.feet):
                 parts.append(
-                    (
-                        in_base(base, angles, motion.spline.point(t)[0]),
-                        stance[i] - dev,
-                        stance[i] + dev,
-                    )
+                    ((base, angles, motion.spline.point(t)[0]), stance[i] - dev, stance[i] + dev)
                 )
-        return stack_rows(self.name, parts)
+        return stack_calls(self.name, in_base, parts)
