@@ -194,15 +194,20 @@ class IntegratorConfig:
     flight_decay_s:
         Time constant [s] with which Δ decays to zero while the foot is in
         flight, so the foot lands where planned.
+    min_load_n:
+        A supporting foot integrates only while its measured vertical force
+        is at least this [N]; below it Δ holds (anti-windup: an unloaded leg
+        cannot move the trunk). 0 integrates on every planned support.
     """
 
     enabled: bool = True
     gain: float = 0.004
     max_offset_m: float = 0.03
     flight_decay_s: float = 0.05
+    min_load_n: float = 1.0
 
     def __post_init__(self) -> None:
-        _nonnegative(self, ("gain",), "integrator")
+        _nonnegative(self, ("gain", "min_load_n"), "integrator")
         _positive(self, ("max_offset_m", "flight_decay_s"), "integrator")
 
 
