@@ -289,6 +289,11 @@ class ReflexConfig:
         After all four feet are down, hold still this long [s] before re-planning.
     lower_s:
         Time [s] to put all four feet down and centre the trunk over them.
+    capture_max_m:
+        Largest capture step [m]: a lifted foot on the side the trunk is
+        moving towards goes down v·√(h/g) further that way (0: straight
+        down). Longer catches harder pushes and may ask for a foot beyond
+        the leg's reach (it then lands as near as the leg gets).
     replan_budget_s:
         Time the anytime planner gets to re-plan [s] (the paper's target: walk
         again within 2 s).
@@ -306,6 +311,7 @@ class ReflexConfig:
     persist_s: float = 0.03
     settle_s: float = 0.3
     lower_s: float = 0.5
+    capture_max_m: float = 0.04
     replan_budget_s: float = 2.0
     max_reflexes: int = 6
 
@@ -323,7 +329,15 @@ class ReflexConfig:
             "reflex",
         )
         _nonnegative(
-            self, ("foot_force_fraction", "foot_force_tilt_rad", "persist_s", "settle_s"), "reflex"
+            self,
+            (
+                "foot_force_fraction",
+                "foot_force_tilt_rad",
+                "persist_s",
+                "settle_s",
+                "capture_max_m",
+            ),
+            "reflex",
         )
         if not (isinstance(self.max_reflexes, int) and self.max_reflexes >= 0):
             raise ConfigError(

@@ -404,6 +404,7 @@ class Executor:
             cfg.lower_s,
             cfg.settle_s,
             now,
+            capture_max_m=cfg.capture_max_m,
         )
         for s in segments:
             self.buffer.append(s)
