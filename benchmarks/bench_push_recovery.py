@@ -11,8 +11,8 @@ This sweep walks the test scenario of ``tests/python/test_sim_run.py``
 motion, and reports per push time whether the robot reached the goal, and
 its reflexes and re-plans.
 
-Run: ``roughwalk bench push_recovery [--impulse 1.0] [--from 1.6] [--to 3.2]
-[--step 0.2] [--terrain flat] [--set KEY=VALUE ...]``. Writes
+Run: ``roughwalk bench push_recovery [--impulse 1.0] [--direction 90]
+[--from 1.6] [--to 3.2] [--step 0.2] [--terrain flat] [--set KEY=VALUE ...]``. Writes
 ``benchmarks/results/push_recovery.json``.
 """
 
@@ -41,6 +41,7 @@ def push_run(
     source: PlannerSource,
     at_s: float,
     impulse: float,
+    direction: float,
     sets: dict[str, Any],
 ) -> dict[str, Any]:
     """One walk with a push at ``at_s`` [s] after the first motion; its outcome and events."""
@@ -51,7 +52,7 @@ def push_run(
         START,
         GOAL,
         planner=source,
-        disturbances=[Push(impulse_ns=impulse, at_s=at_s)],
+        disturbances=[Push(impulse_ns=impulse, at_s=at_s, direction_deg=direction)],
         **{"executor.compute_time_scale": 0.0, **sets},
     )
     o = result.outcome
@@ -72,6 +73,9 @@ def main(argv: list[str] | None = None) -> int:
         prog="roughwalk bench push_recovery", description=__doc__.split("\n")[0]
     )
     ap.add_argument("--impulse", type=float, default=1.0, help="lateral push impulse [N·s]")
+    ap.add_argument(
+        "--direction", type=float, default=90.0, help="push direction from +x [deg] (90: left)"
+    )
     ap.add_argument("--from", dest="first", type=float, default=1.6, help="first push time [s]")
     ap.add_argument("--to", dest="last", type=float, default=3.2, help="last push time [s]")
     ap.add_argument("--step", type=float, default=0.2, help="push time step [s]")
@@ -97,7 +101,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{'push [s]':>8} {'ok':>4} {'reflexes':>8} {'replans':>7}  reason", flush=True)
     runs = []
     for at in times:
-        r = push_run(robot, terrain, source, float(at), args.impulse, sets)
+        r = push_run(robot, terrain, source, float(at), args.impulse, args.direction, sets)
         runs.append(r)
         print(
             f"{r['push_s']:>8.2f} {'yes' if r['success'] else 'no':>4} {r['reflexes']:>8} "
@@ -112,6 +116,7 @@ def main(argv: list[str] | None = None) -> int:
         terrain=args.terrain,
         machine=machine_description(),
         impulse_ns=args.impulse,
+        direction_deg=args.direction,
         expansions=args.expansions,
         set=sets,
         survived=survived,
