@@ -36,12 +36,13 @@ from roughwalk.sim.footstep_source import FootstepSource, PlanAttempt, PlanStart
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
 from roughwalk.sim.outcome import Outcome, OutcomeMonitor
-from roughwalk.sim.recovery import blend_segment, hold_segment, recovery_segment
+from roughwalk.sim.recovery import blend_segment, hold_segment, pose_segment, recovery_segment
 from roughwalk.sim.reflexes import ReflexMonitor
 from roughwalk.sim.run_log import RunLog
 from roughwalk.sim.runner import Runner
 from roughwalk.sim.trajectory_buffer import DesiredState, Segment, TrajectoryBuffer
 from roughwalk.sim.world import World
+from roughwalk.trajectories.euler import matrix_to_rpy
 from roughwalk.trajectories.generator import FootstepTrajectoryGenerator, PreparedPlan
 
 if TYPE_CHECKING:
@@ -429,6 +430,21 @@ class Executor:
         out[joints] = q[joints]
         return out
 
+    def _standing(self, measured: MeasuredState) -> DesiredState:
+        """The measured trunk pose over the measured feet, all four down, as a desired state."""
+        rpy = matrix_to_rpy(measured.rotation)
+        segment = pose_segment(
+            self.robot,
+            np.repeat(measured.base_pos[None], 2, axis=0),
+            np.repeat(rpy[None], 2, axis=0),
+            np.repeat(measured.feet[None], 2, axis=0),
+            np.ones(4, dtype=bool),
+            1e-3,
+            "hold",
+            measured.time,
+        )
+        return segment.last()
+
     @property
     def terrain_for_recovery(self) -> Terrain:
         """The robot puts its feet down on the terrain it believes in (the planner's)."""
@@ -484,6 +500,11 @@ class Executor:
             return True, charged
         segment = Segment.from_footstep(first)
         ready = now + charged
+        # The recovery's pose is not always reached (a foot slid, the trunk
+        # twisted): hold and blend from where the robot stands, as the plan
+        # starts from its measured feet, or the first tick of the blend is
+        # already an orientation error and fires a reflex.
+        holding = self._standing(measured)
         self.buffer.append(hold_segment(holding, max(charged, 1e-3), now, kind="hold"))
         self.buffer.append(blend_segment(self.robot, holding, segment.sample(0.0), 0.2, ready))
         self.buffer.append(segment.with_ready_at(ready))
