@@ -287,6 +287,12 @@ class ReflexConfig:
         An error must last this long [s] to count, so impact transients do not.
     settle_s:
         After all four feet are down, hold still this long [s] before re-planning.
+    settled_rate_rad_s:
+        After ``settle_s`` the hold goes on while the trunk turns faster than
+        this [rad/s] or a foot bears no load (a trunk still rocking from its
+        left feet to its right ones): lifting a foot then tips it over.
+    settle_max_s:
+        Longest extension [s] of the hold for that; then the re-plan starts anyway.
     lower_s:
         Time [s] to put all four feet down and centre the trunk over them.
     capture_max_m:
@@ -310,6 +316,8 @@ class ReflexConfig:
     foot_force_tilt_rad: float = 0.05
     persist_s: float = 0.03
     settle_s: float = 0.3
+    settled_rate_rad_s: float = 0.2
+    settle_max_s: float = 1.5
     lower_s: float = 0.5
     capture_max_m: float = 0.04
     replan_budget_s: float = 2.0
@@ -325,6 +333,7 @@ class ReflexConfig:
                 "foot_force_n",
                 "lower_s",
                 "replan_budget_s",
+                "settled_rate_rad_s",
             ),
             "reflex",
         )
@@ -336,6 +345,7 @@ class ReflexConfig:
                 "persist_s",
                 "settle_s",
                 "capture_max_m",
+                "settle_max_s",
             ),
             "reflex",
         )
