@@ -102,6 +102,21 @@ def test_a_push_beyond_the_threshold_triggers_a_reflex_and_a_replan(littledog) -
     assert blind.outcome.reflexes == 0 and blind.outcome.replans == 0
 
 
+@pytest.mark.parametrize("at_s", [2.0, 2.6])
+def test_one_reflex_rescues_a_push_to_the_right_mid_stride(littledog, at_s: float) -> None:
+    # Pushed right at 2 s (RF about to lift), the robot once went through
+    # five reflexes and fell: the recovery's trunk twisted 12° off its target
+    # yaw, so the re-plan's blend began with an orientation error that fired
+    # the next reflex at once, and each re-plan started from a worse stance.
+    # At 2.6 s the trunk still rocked when the timed hold ended, and the
+    # re-plan's first step, lifting RF, tipped it over.
+    terrain = roughwalk.load_terrain("flat")
+    push = Push(impulse_ns=1.0, at_s=at_s, direction_deg=-90.0)
+    result = walk(littledog, terrain, disturbances=[push])
+    assert result.outcome.reflexes == 1 and result.outcome.replans == 1
+    assert_walked_to_goal(result)
+
+
 def test_a_fall_is_a_failure_with_its_reason(littledog) -> None:
     terrain = roughwalk.load_terrain("flat")
     result = walk(

@@ -48,9 +48,9 @@ def test_centre_of_pressure_is_the_force_weighted_mean_of_the_feet() -> None:
     forces[:, 2] = [10.0, 10.0, 0.0, 20.0]
     forces[:, 0] = 3.0  # tangential forces do not move it
     expected = (10 * feet[0, :2] + 10 * feet[1, :2] + 20 * feet[3, :2]) / 40
-    np.testing.assert_allclose(centre_of_pressure(forces, feet), expected)
+    np.testing.assert_allclose(centre_of_pressure(forces, feet), expected, atol=1e-15)
     forces[2, 2] = -5.0  # a pulling foot counts as unloaded
-    np.testing.assert_allclose(centre_of_pressure(forces, feet), expected)
+    np.testing.assert_allclose(centre_of_pressure(forces, feet), expected, atol=1e-15)
     assert centre_of_pressure(np.zeros((4, 3)), feet) is None
 
 

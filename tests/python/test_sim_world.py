@@ -249,6 +249,7 @@ def test_integrator_decays_in_flight_and_follows_the_update_rule(littledog) -> N
     measured = type("M", (), {})()
     measured.base_pos = desired.base_pos + np.array([0.0, 0.0, -0.01])  # trunk 1 cm low
     measured.rotation = np.eye(3)
+    measured.foot_forces = np.tile([0.0, 0.0, 8.0], (4, 1))  # every foot bears load
     integrator.delta[3] = [0.0, 0.0, 0.02]
     q = integrator.update(desired, measured)
     # Supporting legs: Δ = γ(f_B − f̄_B) = 0.01 · (0, 0, −0.01): lengthen the legs.
@@ -259,6 +260,55 @@ def test_integrator_decays_in_flight_and_follows_the_update_rule(littledog) -> N
     np.testing.assert_allclose(
         feet_b - littledog.foot_positions(desired.q), integrator.delta, atol=1e-9
     )
+
+
+def test_integrator_holds_on_a_planned_support_foot_that_bears_no_load(littledog) -> None:
+    integrator = LegIntegrator(littledog, IntegratorConfig(gain=0.01, min_load_n=1.0), 0.002)
+    desired = standing_segment(littledog).sample(0.0)
+    measured = type("M", (), {})()
+    measured.base_pos = desired.base_pos + np.array([0.0, 0.0, -0.01])
+    measured.rotation = np.eye(3)
+    measured.foot_forces = np.tile([0.0, 0.0, 8.0], (4, 1))
+    measured.foot_forces[1, 2] = 0.5  # RF planned down, lifted off by a rocking trunk
+    integrator.delta[1] = [0.0, 0.0, 0.005]
+    integrator.update(desired, measured)
+    np.testing.assert_allclose(integrator.delta[[0, 2, 3]], [[0.0, 0.0, -1e-4]] * 3, atol=1e-12)
+    # RF's Δ neither grows nor decays.
+    np.testing.assert_array_equal(integrator.delta[1], [0.0, 0.0, 0.005])
+
+
+def _roll_after_a_side_push(robot, terrain, min_load_n: float, impulse_ns: float) -> list[float]:
+    """|Trunk roll| [rad] of the standing robot after a sideways push of ``impulse_ns`` [N·s]."""
+    world = World(robot, terrain)
+    runner = Runner(world)
+    controller = JointController(world)
+    config = IntegratorConfig(min_load_n=min_load_n)
+    integrator = LegIntegrator(robot, config, world.control_dt)
+    desired = standing_segment(robot).sample(0.0)
+    state = runner.reset(desired.q, desired.base_pos, desired.base_quat)
+    rolls = []
+    for k in range(int(2.5 / world.control_dt)):
+        # 0.1 s of force from 0.2 s on.
+        push = [0.0, impulse_ns / 0.1, 0.0] if 100 <= k < 150 else [0.0, 0.0, 0.0]
+        world.data.xfrc_applied[world.base_body, :3] = push
+        q = integrator.update(desired, state)
+        state = runner.step(controller.command(q, desired, state))
+        r = state.rotation
+        rolls.append(float(abs(np.arctan2(r[2, 1], r[2, 2]))))
+    return rolls
+
+
+def test_a_standing_robot_rocked_by_a_push_settles_without_integrator_windup(
+    littledog, flat
+) -> None:
+    # A 1.5 N·s side push rocks LittleDog onto two feet. Integrating the
+    # lifted legs' errors while they hang pumps the rocking until it falls;
+    # holding their Δ (anti-windup) lets it settle.
+    settled = _roll_after_a_side_push(littledog, flat, 1.0, 1.5)
+    assert max(settled) > 0.1  # the push really rocks it (> 6°)
+    assert max(settled[-250:]) < 0.01
+    wound_up = _roll_after_a_side_push(littledog, flat, 0.0, 1.5)
+    assert max(wound_up) > 0.6  # the same push, integrating every planned support: it falls
 
 
 def test_reflex_fires_only_on_errors_that_persist(littledog) -> None:

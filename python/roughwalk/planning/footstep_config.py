@@ -221,7 +221,8 @@ class FootstepConfig:
     max_tree_edges:
         Search-tree edges kept for pictures (0 keeps none).
     cache_capacity:
-        Certificate outcomes cached across plans and re-plans (about 40 bytes each).
+        Certificate outcomes cached across plans and re-plans (about 40 bytes
+        each); when full, the half least recently used is dropped.
     sdf_resolution:
         Voxel size of the terrain's signed distance field [m] (the smaller of
         L/40 and 0.3 c0 [5 mm]).

@@ -194,15 +194,20 @@ class IntegratorConfig:
     flight_decay_s:
         Time constant [s] with which Δ decays to zero while the foot is in
         flight, so the foot lands where planned.
+    min_load_n:
+        A supporting foot integrates only while its measured vertical force
+        is at least this [N]; below it Δ holds (anti-windup: an unloaded leg
+        cannot move the trunk). 0 integrates on every planned support.
     """
 
     enabled: bool = True
     gain: float = 0.004
     max_offset_m: float = 0.03
     flight_decay_s: float = 0.05
+    min_load_n: float = 1.0
 
     def __post_init__(self) -> None:
-        _nonnegative(self, ("gain",), "integrator")
+        _nonnegative(self, ("gain", "min_load_n"), "integrator")
         _positive(self, ("max_offset_m", "flight_decay_s"), "integrator")
 
 
@@ -282,8 +287,19 @@ class ReflexConfig:
         An error must last this long [s] to count, so impact transients do not.
     settle_s:
         After all four feet are down, hold still this long [s] before re-planning.
+    settled_rate_rad_s:
+        After ``settle_s`` the hold goes on while the trunk turns faster than
+        this [rad/s] or a foot bears no load (a trunk still rocking from its
+        left feet to its right ones): lifting a foot then tips it over.
+    settle_max_s:
+        Longest extension [s] of the hold for that; then the re-plan starts anyway.
     lower_s:
         Time [s] to put all four feet down and centre the trunk over them.
+    capture_max_m:
+        Largest capture step [m]: a lifted foot on the side the trunk is
+        moving towards goes down v·√(h/g) further that way (0: straight
+        down). Longer catches harder pushes and may ask for a foot beyond
+        the leg's reach (it then lands as near as the leg gets).
     replan_budget_s:
         Time the anytime planner gets to re-plan [s] (the paper's target: walk
         again within 2 s).
@@ -300,7 +316,10 @@ class ReflexConfig:
     foot_force_tilt_rad: float = 0.05
     persist_s: float = 0.03
     settle_s: float = 0.3
+    settled_rate_rad_s: float = 0.2
+    settle_max_s: float = 1.5
     lower_s: float = 0.5
+    capture_max_m: float = 0.04
     replan_budget_s: float = 2.0
     max_reflexes: int = 6
 
@@ -314,11 +333,21 @@ class ReflexConfig:
                 "foot_force_n",
                 "lower_s",
                 "replan_budget_s",
+                "settled_rate_rad_s",
             ),
             "reflex",
         )
         _nonnegative(
-            self, ("foot_force_fraction", "foot_force_tilt_rad", "persist_s", "settle_s"), "reflex"
+            self,
+            (
+                "foot_force_fraction",
+                "foot_force_tilt_rad",
+                "persist_s",
+                "settle_s",
+                "capture_max_m",
+                "settle_max_s",
+            ),
+            "reflex",
         )
         if not (isinstance(self.max_reflexes, int) and self.max_reflexes >= 0):
             raise ConfigError(

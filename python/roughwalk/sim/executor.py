@@ -36,12 +36,13 @@ from roughwalk.sim.footstep_source import FootstepSource, PlanAttempt, PlanStart
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
 from roughwalk.sim.outcome import Outcome, OutcomeMonitor
-from roughwalk.sim.recovery import blend_segment, hold_segment, recovery_segment
+from roughwalk.sim.recovery import blend_segment, hold_segment, pose_segment, recovery_segment
 from roughwalk.sim.reflexes import ReflexMonitor
 from roughwalk.sim.run_log import RunLog
 from roughwalk.sim.runner import Runner
 from roughwalk.sim.trajectory_buffer import DesiredState, Segment, TrajectoryBuffer
 from roughwalk.sim.world import World
+from roughwalk.trajectories.euler import matrix_to_rpy
 from roughwalk.trajectories.generator import FootstepTrajectoryGenerator, PreparedPlan
 
 if TYPE_CHECKING:
@@ -58,6 +59,10 @@ ProgressCallback = Callable[[float, float, str], None]
 """Called every simulated tenth of a second with (sim time [s], progress 0–1, mode)."""
 
 _SETTLE_BEFORE_S = 0.3
+# How long [s] the recovery's hold is extended at a time while the robot
+# still rocks, and the vertical force [N] of a foot that bears load.
+_SETTLE_TICK_S = 0.02
+_LOADED_N = 1.0
 # How far [m] a foot may have settled from its planned foothold for a re-plan
 # to start from the planned one.
 _NEAR_PLAN_M = 0.025
@@ -133,6 +138,8 @@ class Executor:
         self._plan: _Plan | None = None
         self._step_index = 0
         self._leg_joints = np.asarray(robot.canonical_index).reshape(4, 3)
+        # When the recovery's hold stops waiting for the robot to settle [s].
+        self._settle_deadline: float | None = None
 
     # ---- planning -------------------------------------------------------------------
 
@@ -244,7 +251,10 @@ class Executor:
             if desired is None:
                 break
             if current is None and not self.buffer.queued:
-                if mode == "recovery":
+                if mode == "recovery" and not self._settled(measured, now):
+                    # Still rocking: hold a little longer before lifting a foot.
+                    self.buffer.append(hold_segment(desired, _SETTLE_TICK_S, now, "recovery"))
+                elif mode == "recovery":
                     # Settled on four feet: re-plan from where they stand (§6, §4.5).
                     replans += 1
                     ok, charged = self._replan(measured, desired, goal, now)
@@ -388,6 +398,7 @@ class Executor:
         current = self.buffer.current
         planned = current.last().feet if current is not None else desired.feet
         self._reflex_next_leg = self._next_leg(desired)
+        self._settle_deadline = None
         self._reflex_planned_feet = np.array(planned, dtype=float)
         in_contact = measured.foot_forces[:, 2] > 1.0
         self._plan = None
@@ -404,6 +415,7 @@ class Executor:
             cfg.lower_s,
             cfg.settle_s,
             now,
+            capture_max_m=cfg.capture_max_m,
         )
         for s in segments:
             self.buffer.append(s)
@@ -411,6 +423,25 @@ class Executor:
         state, _, _ = self.buffer.advance(now)
         assert state is not None
         return state
+
+    def _settled(self, measured: MeasuredState, now: float) -> bool:
+        """Whether the recovered robot stands still on four feet, or has held long enough.
+
+        The recovery's hold is timed (``reflex.settle_s``), but a push can
+        leave the trunk rocking from its left feet to its right ones after
+        it; a re-plan whose first step lifts a foot then tips the robot
+        over and fires the next reflex. So the hold goes on, up to
+        ``reflex.settle_max_s`` more, until the trunk turns slower than
+        ``reflex.settled_rate_rad_s`` with every foot bearing load.
+        """
+        cfg = self.config.reflex
+        if self._settle_deadline is None:
+            self._settle_deadline = now + cfg.settle_max_s
+        if now >= self._settle_deadline - 1e-9:
+            return True
+        turning = float(np.linalg.norm(measured.base_angvel))
+        loaded = bool(np.all(measured.foot_forces[:, 2] > _LOADED_N))
+        return turning < cfg.settled_rate_rad_s and loaded
 
     def _catch(
         self, q_cmd: np.ndarray, desired: DesiredState, measured: MeasuredState
@@ -427,6 +458,21 @@ class Executor:
         out = q_cmd.copy()
         out[joints] = q[joints]
         return out
+
+    def _standing(self, measured: MeasuredState) -> DesiredState:
+        """The measured trunk pose over the measured feet, all four down, as a desired state."""
+        rpy = matrix_to_rpy(measured.rotation)
+        segment = pose_segment(
+            self.robot,
+            np.repeat(measured.base_pos[None], 2, axis=0),
+            np.repeat(rpy[None], 2, axis=0),
+            np.repeat(measured.feet[None], 2, axis=0),
+            np.ones(4, dtype=bool),
+            1e-3,
+            "hold",
+            measured.time,
+        )
+        return segment.last()
 
     @property
     def terrain_for_recovery(self) -> Terrain:
@@ -483,6 +529,16 @@ class Executor:
             return True, charged
         segment = Segment.from_footstep(first)
         ready = now + charged
+        # The recovery's pose is not always reached (a foot slid, the trunk
+        # twisted): hold and blend from where the robot stands, as the plan
+        # starts from its measured feet, or the first tick of the blend is
+        # already an orientation error and fires a reflex.
+        holding = self._standing(measured)
+        # The integrators and the CoP shift corrected the recovery's pose; the
+        # new one is where the robot stands, so their corrections start anew
+        # (kept, they would move the feet off the measured stance at once).
+        self.integrator.reset()
+        self.stabilizer.reset()
         self.buffer.append(hold_segment(holding, max(charged, 1e-3), now, kind="hold"))
         self.buffer.append(blend_segment(self.robot, holding, segment.sample(0.0), 0.2, ready))
         self.buffer.append(segment.with_ready_at(ready))

@@ -9,7 +9,9 @@ the observed trunk is f̄_B = R̄ᵀ(f_W − x̄), and each supporting leg runs
 
 shortening a leg when the trunk is too high and lengthening it when too
 low. While a foot is in flight its Δ decays to zero, so it lands where
-planned. f_B is taken as FK_B(q_d), the body-frame foot of the desired joint
+planned; while a foot planned to support bears no load (a trunk rocking
+onto its other feet) its Δ holds, since that leg cannot move the trunk.
+f_B is taken as FK_B(q_d), the body-frame foot of the desired joint
 angles, which for a supporting leg is the same point and for a swing leg
 follows its swing.
 """
@@ -80,7 +82,13 @@ class LegIntegrator:
         f_b = (f_w - desired.base_pos) @ rot
         f_b_bar = (f_w - measured.base_pos) @ rot_bar
         down = desired.support
-        self.delta[down] += cfg.gain * (f_b[down] - f_b_bar[down])
+        # Anti-windup: a planned supporting foot that bears no load cannot move
+        # the trunk, so its Δ holds still. Integrating there (a trunk rocking on
+        # two feet, the other two in the air) lengthens the lifted legs while
+        # they hang, and they kick the trunk back when they land: the rocking
+        # grows until the robot falls (a 1.5 N·s push on a standing LittleDog).
+        acting = down & (np.asarray(measured.foot_forces)[:, 2] >= cfg.min_load_n)
+        self.delta[acting] += cfg.gain * (f_b[acting] - f_b_bar[acting])
         self.delta[~down] *= self._decay
         norm = np.linalg.norm(self.delta, axis=1, keepdims=True)
         self.delta *= np.minimum(1.0, cfg.max_offset_m / np.maximum(norm, 1e-12))

@@ -5,7 +5,10 @@ all four feet firmly on the ground". :func:`recovery_segment` does it in
 three parts, from the measured state:
 
 1. every foot off the ground goes down, fast: straight below where it is
-   (to its planned foothold if that is within 2 cm); the trunk holds still;
+   (to its planned foothold if that is within 2 cm); the trunk holds still.
+   A trunk moving towards a lifted foot's side (a push) moves that foot's
+   target by the capture offset v·√(h/g) (the linear inverted pendulum's
+   capture point), so the support polygon reaches where the trunk is going;
 2. the trunk moves over the four feet, to the nominal stance fitted to them
    (its centre of mass then near the middle of the support polygon);
 3. it holds still so the robot settles before re-planning.
@@ -175,6 +178,23 @@ def blend_segment(
     )
 
 
+def _capture_offset(
+    measured: MeasuredState, feet: NDArray[np.float64], limit: float
+) -> NDArray[np.float64]:
+    """The capture offset v·√(h/g) (2,) [m] of the trunk, at most ``limit`` [m] long.
+
+    The linear inverted pendulum's capture point (Pratt et al. 2006): where a
+    foot must be for a trunk at height h over the feet, moving at v, to come
+    to rest over it.
+    """
+    if limit <= 0.0:
+        return np.zeros(2)
+    height = max(float(measured.base_pos[2] - feet[:, 2].mean()), 0.0)
+    offset = np.asarray(measured.base_vel[:2], dtype=float) * np.sqrt(height / _GRAVITY)
+    norm = float(np.linalg.norm(offset))
+    return offset * (limit / norm) if norm > limit else offset
+
+
 def recovery_segment(
     robot: Robot,
     terrain: Terrain,
@@ -185,6 +205,7 @@ def recovery_segment(
     settle_s: float,
     ready_at: float,
     press_m: float = 0.0,
+    capture_max_m: float = 0.0,
 ) -> tuple[list[Segment], NDArray[np.float64]]:
     """The reflex's motion from ``measured``: feet down, trunk over them, hold.
 
@@ -200,6 +221,8 @@ def recovery_segment(
         Hold time [s] at the end.
     press_m:
         How far [m] below the terrain surface the lowered feet aim.
+    capture_max_m:
+        Largest capture offset [m] of a lowered foot (0: straight down).
 
     Returns the segments and the four footholds (4, 3) [m] the robot ends on.
     """
@@ -208,12 +231,18 @@ def recovery_segment(
     rpy = matrix_to_rpy(measured.rotation)
     start_feet = measured.feet.copy()
     target = start_feet.copy()
+    capture = _capture_offset(measured, start_feet, capture_max_m)
+    centre = start_feet[:, :2].mean(axis=0)
     for leg in np.flatnonzero(~np.asarray(in_contact, dtype=bool)):
-        # Straight down is the quickest catch; the planned foothold only when
-        # the foot is nearly over it already.
+        # Straight down is the quickest catch, moved out by the capture offset
+        # when the trunk heads for this foot's side; the planned foothold only
+        # when the foot is nearly over that point already.
+        catch = start_feet[leg].copy()
+        if float(capture @ (start_feet[leg, :2] - centre)) > 0.0:
+            catch[:2] += capture
         goal = np.asarray(planned_feet[leg], dtype=float).copy()
-        if np.linalg.norm(goal[:2] - start_feet[leg, :2]) > 0.02:
-            goal = start_feet[leg].copy()
+        if np.linalg.norm(goal[:2] - catch[:2]) > 0.02:
+            goal = catch
         # "Firmly on the ground": aim a little into it, so the servo presses
         # the foot down and the pressing legs stop the trunk tipping.
         goal[2] = float(terrain.height(goal[None, :2])[0]) + r - press_m

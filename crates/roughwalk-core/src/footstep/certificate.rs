@@ -16,7 +16,7 @@
 use crate::footstep::collision::{Clearance, CollisionModel};
 use crate::footstep::config::CertificateConfig;
 use crate::footstep::mass_model::MassModel;
-use crate::kinematics::body_pose::point_pose_jacobians;
+use crate::kinematics::body_pose::point_pose_jacobians_at;
 use crate::kinematics::leg::{IkResult, LegChain, LinkFrames};
 use crate::kinematics::math::{
     add, cross, det, dot, exp_so3, mat_mul, mat_t_vec, mat_to_quat, mat_vec, norm, scale, sub,
@@ -385,6 +385,8 @@ impl CertificateSearch<'_> {
                 // the target's radial projection: one analytic IK instead of
                 // the exact closest-point search, 30-50x dearer (§3.2 needs
                 // only the direction and size of the error).
+                // Inside it, a target the joint limits keep the foot from
+                // gets the clamped analytic solution, for the same reason.
                 let (ik, leg_frames) = match self.reach[i].aim(target) {
                     Some(aim) => match leg.ik_exact(aim, None) {
                         Some((near, near_frames)) => {
@@ -394,9 +396,9 @@ impl CertificateSearch<'_> {
                             };
                             (near, near_frames)
                         }
-                        None => leg.ik_with_frames(target, None),
+                        None => leg.ik_or_clamped(target, None),
                     },
-                    None => leg.ik_with_frames(target, None),
+                    None => leg.ik_or_clamped(target, None),
                 };
                 q[3 * i..3 * i + 3].copy_from_slice(&ik.q);
                 frames[i] = leg_frames;
@@ -438,7 +440,7 @@ impl CertificateSearch<'_> {
             let collision = closest.filter(|c| c.distance < required);
             if let Some(c) = collision {
                 violation += required - c.distance;
-                self.obstacle_step(feet, &pose, &c, required, &mut dx, &mut omega);
+                self.obstacle_step(feet, &pose, &frames, &c, required, &mut dx, &mut omega);
             }
             if reachable && com_ok && collision.is_none() {
                 return Ok(self.certificate(&pose, q, &frames, com, com_margin, closest, iteration));
@@ -486,6 +488,7 @@ impl CertificateSearch<'_> {
         &self,
         feet: &[Vec3; 4],
         pose: &BodyPose,
+        frames: &[LinkFrames; 4],
         c: &Clearance,
         required: f64,
         dx: &mut Vec3,
@@ -497,8 +500,7 @@ impl CertificateSearch<'_> {
             return;
         }
         let g = scale(c.gradient, 1.0 / g_len);
-        let Ok(jac) = point_pose_jacobians(self.robot, feet, pose.x, mat_to_quat(&pose.r), c.point)
-        else {
+        let Ok(jac) = point_pose_jacobians_at(self.robot, pose, feet, frames, c.point) else {
             return;
         };
         let (a, b) = (mat_t_vec(&jac.j_x, g), mat_t_vec(&jac.j_r, g));

@@ -18,17 +18,15 @@ const LIPSCHITZ: f64 = 1.732_050_808_568_877_3;
 /// The field's value [m] at `p` without its gradient (the trilinear value of
 /// the lattice cell, or the exact fall-back outside the lattice): capsule
 /// marching needs only values, and the gradient only at the minimum.
-#[inline]
+// Measured: LLVM left these out of the capsule-marching loop, ~6 % of a
+// certificate's instructions on the rocky probe.
+#[allow(clippy::inline_always)]
+#[inline(always)]
 fn distance(sdf: &SignedDistanceField, p: Vec3) -> f64 {
-    let grid = sdf.grid();
-    let Some((base, [tx, ty, tz])) = grid.locate(p) else {
-        return sdf.distance_and_gradient(p).0;
-    };
-    let c = grid.corners(base).map(f64::from);
-    let lerp = |a: f64, b: f64, t: f64| a + (b - a) * t;
-    let f0 = lerp(lerp(c[0], c[1], tz), lerp(c[2], c[3], tz), ty);
-    let f1 = lerp(lerp(c[4], c[5], tz), lerp(c[6], c[7], tz), ty);
-    lerp(f0, f1, tx)
+    match sdf.grid().value(p) {
+        Some(v) => v,
+        None => sdf.distance_and_gradient(p).0,
+    }
 }
 
 /// A capsule fixed to the trunk or to a leg link (a sphere when a = b).

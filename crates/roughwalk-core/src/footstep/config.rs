@@ -142,7 +142,8 @@ pub struct FootstepConfig {
     /// Most search-tree edges kept for pictures (0 keeps none).
     pub max_tree_edges: usize,
     /// Most certificate outcomes kept in the cache shared by plans and
-    /// re-plans on the same terrain; the cache is emptied when full.
+    /// re-plans on the same terrain; when full, the half least recently
+    /// used is dropped.
     pub cache_capacity: usize,
 }
 

@@ -8,11 +8,13 @@
 //! the lattice), [`actions`] (action targets and the local search),
 //! [`cost_map`] (footholds and terrain costs on the lattice),
 //! [`mass_model`] (whole-body centre of mass), [`collision`] (capsules vs
-//! the distance field), [`certificate`] (§4.4), [`model`] (successors,
+//! the distance field), [`certificate`] (§4.4), [`certificate_cache`]
+//! (certificate outcomes kept across plans), [`model`] (successors,
 //! costs, heuristic), [`planner`] (the plan call).
 
 pub mod actions;
 pub mod certificate;
+pub mod certificate_cache;
 pub mod collision;
 pub mod config;
 pub mod cost_map;

@@ -9,7 +9,7 @@
 //! and clearance penalties) and a per-step constant. An action without a
 //! pose certificate is pruned.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 use std::hash::{BuildHasherDefault, Hasher};
 
 use crate::dubins::{dubins_heuristic, euclidean_heuristic};
@@ -18,6 +18,7 @@ use crate::footstep::actions::{action_target, LocalSearch};
 use crate::footstep::certificate::{
     CertificateFailure, CertificateSearch, LegReach, PoseCertificate,
 };
+use crate::footstep::certificate_cache::CertificateCache;
 use crate::footstep::collision::CollisionModel;
 use crate::footstep::config::{FootstepConfig, HeuristicKind};
 use crate::footstep::cost_map::CostMap;
@@ -145,7 +146,7 @@ pub struct FootstepModel {
     dubins_per_metre: f64,
     sdf_error: f64,
     reach: [LegReach; 4],
-    cache: HashMap<FootstepState, Outcome, BuildHasherDefault<FxHasher>>,
+    cache: CertificateCache<FootstepState, Outcome, BuildHasherDefault<FxHasher>>,
     tree: Vec<TreeEdge>,
     /// States already drawn in `tree` (bounded by its cap).
     tree_seen: HashSet<FootstepState, BuildHasherDefault<FxHasher>>,
@@ -224,7 +225,7 @@ impl FootstepModel {
             dubins_per_metre,
             sdf_error,
             reach,
-            cache: HashMap::default(),
+            cache: CertificateCache::new(config.cache_capacity),
             tree: Vec::new(),
             tree_seen: HashSet::default(),
             counters: ModelCounters::default(),
@@ -330,7 +331,7 @@ impl FootstepModel {
 
     /// The cached certificate outcome of `s`, and whether it was computed now.
     fn pose_outcome(&mut self, s: &FootstepState) -> (Outcome, bool) {
-        if let Some(&o) = self.cache.get(s) {
+        if let Some(o) = self.cache.get(s) {
             self.counters.certificate_cache_hits += 1;
             return (o, false);
         }
@@ -342,12 +343,7 @@ impl FootstepModel {
         if let Err(f) = outcome {
             self.counters.certificate_failures[f as usize] += 1;
         }
-        if self.cache.len() >= self.config.cache_capacity {
-            self.cache.clear();
-        }
-        if self.config.cache_capacity > 0 {
-            self.cache.insert(*s, outcome);
-        }
+        self.cache.insert(*s, outcome);
         (outcome, true)
     }
 

@@ -7,7 +7,7 @@
 //! ω in the world frame, and the value of the step's objective before it.
 
 use crate::error::{CoreError, CoreResult};
-use crate::kinematics::leg::LegChain;
+use crate::kinematics::leg::{LegChain, LinkFrames};
 use crate::kinematics::math::{
     add, cross, exp_so3, inverse, mat_mul, mat_sub, mat_t_vec, mat_vec, norm, scale, skew, sub,
     transpose, Mat3, Quat, Vec3, IDENTITY,
@@ -160,38 +160,80 @@ pub fn point_pose_jacobians(
 ) -> CoreResult<PointPoseJacobians> {
     check_points("feet", feet_world)?;
     let pose = BodyPose::new(base_pos, base_quat)?;
-    let r = &pose.r;
-    let rt = transpose(r);
     match point {
         CollisionPoint::Trunk(p_b) => {
             check_points("point", &[p_b])?;
-            Ok(PointPoseJacobians {
-                p: pose.to_world(p_b),
-                j_x: IDENTITY,
-                j_r: scale_mat(&skew(mat_vec(r, p_b)), -1.0),
-            })
+            Ok(trunk_point_jacobians(&pose, p_b))
         }
         CollisionPoint::Leg { leg, link, point } => {
             check_points("point", &[point])?;
-            let chain: &LegChain = robot.legs().get(leg).ok_or_else(|| {
-                CoreError::InvalidArgument(format!(
-                    "leg index {leg} out of range; valid: 0..4 (LF, RF, LH, RH)"
-                ))
-            })?;
+            let chain = leg_chain(robot, leg)?;
             let f_b = pose.to_body(feet_world[leg]);
-            let q = chain.ik(f_b, None).q;
-            let (p_b, j_p) = chain.point_jacobian(q, link, point)?;
-            let m = mat_mul(&j_p, &foot_jacobian_inverse(&chain.jacobian(q)));
-            let j_x = mat_sub(&IDENTITY, &mat_mul(&mat_mul(r, &m), &rt));
-            let inner = mat_sub(&mat_mul(&m, &skew(f_b)), &skew(p_b));
-            let j_r = mat_mul(&mat_mul(r, &inner), &rt);
-            Ok(PointPoseJacobians {
-                p: pose.to_world(p_b),
-                j_x,
-                j_r,
-            })
+            let (_, frames) = chain.ik_with_frames(f_b, None);
+            leg_point_jacobians(chain, &pose, f_b, &frames, link, point)
         }
     }
+}
+
+/// [`point_pose_jacobians`] at the trunk pose `pose` from the legs' link
+/// frames `frames` at their IK solutions for the feet `feet_world` [m]: the
+/// pose-certificate search holds those from its round's IK and need not
+/// solve it again. No checks of finiteness.
+pub fn point_pose_jacobians_at(
+    robot: &Quadruped,
+    pose: &BodyPose,
+    feet_world: &[Vec3; 4],
+    frames: &[LinkFrames; 4],
+    point: CollisionPoint,
+) -> CoreResult<PointPoseJacobians> {
+    match point {
+        CollisionPoint::Trunk(p_b) => Ok(trunk_point_jacobians(pose, p_b)),
+        CollisionPoint::Leg { leg, link, point } => {
+            let chain = leg_chain(robot, leg)?;
+            let f_b = pose.to_body(feet_world[leg]);
+            leg_point_jacobians(chain, pose, f_b, &frames[leg], link, point)
+        }
+    }
+}
+
+fn leg_chain(robot: &Quadruped, leg: usize) -> CoreResult<&LegChain> {
+    robot.legs().get(leg).ok_or_else(|| {
+        CoreError::InvalidArgument(format!(
+            "leg index {leg} out of range; valid: 0..4 (LF, RF, LH, RH)"
+        ))
+    })
+}
+
+/// A trunk point moves rigidly: J_p(x) = I, J_p(R) = −[R·p_B]×.
+fn trunk_point_jacobians(pose: &BodyPose, p_b: Vec3) -> PointPoseJacobians {
+    PointPoseJacobians {
+        p: pose.to_world(p_b),
+        j_x: IDENTITY,
+        j_r: scale_mat(&skew(mat_vec(&pose.r, p_b)), -1.0),
+    }
+}
+
+/// A point on link `link` of `chain`, whose link frames at IK_B(f_B) are `frames`.
+fn leg_point_jacobians(
+    chain: &LegChain,
+    pose: &BodyPose,
+    f_b: Vec3,
+    frames: &LinkFrames,
+    link: usize,
+    point: Vec3,
+) -> CoreResult<PointPoseJacobians> {
+    let r = &pose.r;
+    let rt = transpose(r);
+    let (p_b, j_p) = chain.point_jacobian_at(frames, link, point)?;
+    let m = mat_mul(&j_p, &foot_jacobian_inverse(&chain.jacobian_at(frames)));
+    let j_x = mat_sub(&IDENTITY, &mat_mul(&mat_mul(r, &m), &rt));
+    let inner = mat_sub(&mat_mul(&m, &skew(f_b)), &skew(p_b));
+    let j_r = mat_mul(&mat_mul(r, &inner), &rt);
+    Ok(PointPoseJacobians {
+        p: pose.to_world(p_b),
+        j_x,
+        j_r,
+    })
 }
 
 fn scale_mat(m: &Mat3, s: f64) -> Mat3 {
@@ -354,8 +396,18 @@ mod tests {
             },
         ];
         let h = 1e-6;
+        let pose = BodyPose::new(POS, QUAT).unwrap();
+        // The certificate's variant, from link frames of the IK it already solved.
+        let frames: [LinkFrames; 4] = std::array::from_fn(|i| {
+            let q = robot.legs()[i].ik(pose.to_body(feet[i]), None).q;
+            robot.legs()[i].link_frames(q)
+        });
         for point in points {
             let jac = point_pose_jacobians(&robot, &feet, POS, QUAT, point).unwrap();
+            let at = point_pose_jacobians_at(&robot, &pose, &feet, &frames, point).unwrap();
+            assert!(norm(sub(at.p, jac.p)) < 1e-15);
+            assert_mat_close(&at.j_x, &jac.j_x, 1e-14);
+            assert_mat_close(&at.j_r, &jac.j_r, 1e-14);
             let column = |k: usize, rotational: bool| {
                 let mut e = [0.0; 3];
                 e[k] = h;

@@ -6,8 +6,8 @@
 
 use crate::error::{CoreError, CoreResult};
 use crate::kinematics::math::{
-    add, axis_angle, cross, from_columns, mat_mul, mat_vec, norm, quat_normalize, quat_to_mat,
-    scale, sub, Mat3, Quat, Vec3,
+    add, cross, from_columns, mat_mul, mat_vec, norm, quat_normalize, quat_to_mat, scale, skew,
+    sub, Mat3, Quat, Vec3,
 };
 
 /// The foot is "on" its target when it is this close [m].
@@ -94,9 +94,47 @@ pub struct LegChain {
     arcs: Vec<closest::PlanarArc>,
     /// The HAA scan of the closest-point search.
     scan: closest::HaaScan,
-    /// The HAA body's placement on the trunk (see `placement`): the same
-    /// for every q, so link frames start from it.
-    haa_placement: (Mat3, Vec3, Vec3),
+    /// Each joint's hinge in its parent body's frame (boxed: legs are
+    /// passed around by value in arrays of four).
+    hinges: Box<[Hinge; 3]>,
+}
+
+/// Joint k's hinge transform with everything that does not depend on q_k
+/// folded in, in the parent body's frame: the body's rotation is
+/// B_k·Rot(a_k, q_k) = B_k + sin q_k·B_k[a_k]× + (1 − cos q_k)·B_k[a_k]×²
+/// (Rodrigues), which spares building Rot and one matrix product per joint.
+#[derive(Debug, Clone, PartialEq)]
+struct Hinge {
+    /// B_k, B_k[a_k]×, B_k[a_k]×².
+    rot: [Mat3; 3],
+    /// The joint's anchor and unit axis in the parent's frame [m].
+    anchor: Vec3,
+    axis: Vec3,
+    /// The anchor in body k's own frame (MuJoCo `jnt_pos`) [m].
+    anchor_local: Vec3,
+}
+
+impl Hinge {
+    fn new(p: &LegParams, body_rot: &[Mat3; 3], k: usize) -> Self {
+        let b = body_rot[k];
+        let a = skew(p.axis[k]);
+        let ba = mat_mul(&b, &a);
+        Self {
+            rot: [b, ba, mat_mul(&ba, &a)],
+            anchor: add(p.body_pos[k], mat_vec(&b, p.anchor[k])),
+            axis: mat_vec(&b, p.axis[k]),
+            anchor_local: p.anchor[k],
+        }
+    }
+
+    /// B_k·Rot(a_k, q) [rotation, parent frame].
+    #[inline]
+    fn rotation(&self, q: f64) -> Mat3 {
+        let (s, c) = q.sin_cos();
+        let t = 1.0 - c;
+        let [b, b1, b2] = &self.rot;
+        std::array::from_fn(|i| std::array::from_fn(|j| b[i][j] + s * b1[i][j] + t * b2[i][j]))
+    }
 }
 
 fn check_finite(name: &str, what: &str, values: &[f64]) -> CoreResult<()> {
@@ -179,13 +217,7 @@ impl LegChain {
         let ik_geometry = ik::IkGeometry::new(name, &params, &body_rot)?;
         let arcs = closest::planar_arcs(&ik_geometry, params.lower, params.upper);
         let scan = closest::haa_scan(&ik_geometry, params.lower, params.upper);
-        let haa_placement = Self::placement(
-            &params,
-            &body_rot,
-            0,
-            [0.0; 3],
-            &crate::kinematics::math::IDENTITY,
-        );
+        let hinges = Box::new([0, 1, 2].map(|k| Hinge::new(&params, &body_rot, k)));
         Ok(Self {
             name: name.to_owned(),
             params,
@@ -194,7 +226,7 @@ impl LegChain {
             ik_geometry,
             arcs,
             scan,
-            haa_placement,
+            hinges,
         })
     }
 
@@ -222,49 +254,28 @@ impl LegChain {
 
     /// Pose of every joint body, with the joints' world anchors and axes, in the base frame.
     pub fn link_frames(&self, q: Vec3) -> LinkFrames {
-        let p = &self.params;
-        let mut parent_pos = [0.0; 3];
-        let mut parent_rot = crate::kinematics::math::IDENTITY;
+        // MuJoCo's mj_kinematics for a hinge: place the body on its parent,
+        // then rotate it about the joint's anchor.
+        let h = &self.hinges;
+        // HAA's parent is the trunk itself.
+        let rot0 = h[0].rotation(q[0]);
+        let pos0 = sub(h[0].anchor, mat_vec(&rot0, h[0].anchor_local));
         let mut out = LinkFrames {
-            pos: [[0.0; 3]; 3],
-            rot: [parent_rot; 3],
-            anchor: [[0.0; 3]; 3],
-            axis: [[0.0; 3]; 3],
+            pos: [pos0, [0.0; 3], [0.0; 3]],
+            rot: [rot0, rot0, rot0],
+            anchor: [h[0].anchor, [0.0; 3], [0.0; 3]],
+            axis: [h[0].axis, [0.0; 3], [0.0; 3]],
         };
-        for (k, &angle) in q.iter().enumerate() {
-            // MuJoCo's mj_kinematics for a hinge: place the body, then rotate it about the anchor.
-            let (rot0, anchor, axis) = if k == 0 {
-                self.haa_placement
-            } else {
-                Self::placement(p, &self.body_rot, k, parent_pos, &parent_rot)
-            };
-            let rot = mat_mul(&rot0, &axis_angle(p.axis[k], angle));
-            let pos = sub(anchor, mat_vec(&rot, p.anchor[k]));
-            out.pos[k] = pos;
+        for k in 1..3 {
+            let (parent_pos, parent_rot) = (out.pos[k - 1], out.rot[k - 1]);
+            let rot = mat_mul(&parent_rot, &h[k].rotation(q[k]));
+            let anchor = add(parent_pos, mat_vec(&parent_rot, h[k].anchor));
+            out.pos[k] = sub(anchor, mat_vec(&rot, h[k].anchor_local));
             out.rot[k] = rot;
             out.anchor[k] = anchor;
-            out.axis[k] = axis;
-            parent_pos = pos;
-            parent_rot = rot;
+            out.axis[k] = mat_vec(&parent_rot, h[k].axis);
         }
         out
-    }
-
-    /// Body `k` placed on its parent (at `parent_pos`, `parent_rot`) before
-    /// its joint turns: its rotation, and its joint's anchor and axis in the
-    /// base frame.
-    #[inline]
-    fn placement(
-        p: &LegParams,
-        body_rot: &[Mat3; 3],
-        k: usize,
-        parent_pos: Vec3,
-        parent_rot: &Mat3,
-    ) -> (Mat3, Vec3, Vec3) {
-        let pos0 = add(parent_pos, mat_vec(parent_rot, p.body_pos[k]));
-        let rot0 = mat_mul(parent_rot, &body_rot[k]);
-        let anchor = add(pos0, mat_vec(&rot0, p.anchor[k]));
-        (rot0, anchor, mat_vec(&rot0, p.axis[k]))
     }
 
     /// Foot centre in the base frame, FK_B(q) [m].
@@ -300,15 +311,32 @@ impl LegChain {
     /// link `link` (0 hip, 1 thigh, 2 shank: the bodies of joints 1–3), given
     /// in that link's frame [m]. Columns of joints after `link` are zero.
     pub fn point_jacobian(&self, q: Vec3, link: usize, point: Vec3) -> CoreResult<(Vec3, Mat3)> {
+        self.point_jacobian_at(&self.link_frames(q), link, point)
+    }
+
+    /// [`Self::point_jacobian`] from the link frames `f` of the joint angles
+    /// (as [`Self::link_frames`] or the IK with frames give them), for
+    /// callers that already hold them.
+    pub fn point_jacobian_at(
+        &self,
+        f: &LinkFrames,
+        link: usize,
+        point: Vec3,
+    ) -> CoreResult<(Vec3, Mat3)> {
         if link > 2 {
             return Err(CoreError::InvalidArgument(format!(
                 "leg '{}': link index {link} out of range; valid: 0 (hip), 1 (thigh), 2 (shank)",
                 self.name
             )));
         }
-        let f = self.link_frames(q);
         let p = add(f.pos[link], mat_vec(&f.rot[link], point));
-        Ok((p, Self::columns(&f, p, link)))
+        Ok((p, Self::columns(f, p, link)))
+    }
+
+    /// The foot Jacobian ∂FK_B/∂q [m/rad] from the link frames `f` of the joint angles.
+    pub fn jacobian_at(&self, f: &LinkFrames) -> Mat3 {
+        let foot = add(f.pos[2], mat_vec(&f.rot[2], self.params.foot));
+        Self::columns(f, foot, 2)
     }
 }
 
@@ -422,6 +450,39 @@ pub(crate) mod tests {
         let knee = [0.101, 0.05985, -0.0917];
         let expected = add(knee, [-0.0985, 0.0, 0.0265]);
         assert!(norm(sub(g, expected)) < 1e-15, "{g:?}");
+    }
+
+    #[test]
+    fn link_frames_follow_mujocos_hinge_transform() {
+        // T_k = T_{k-1}·[R(body_quat_k), body_pos_k]·Trans(anchor_k)·Rot(axis_k, q_k)·Trans(−anchor_k),
+        // composed plainly.
+        for leg in test_legs() {
+            let p = leg.params();
+            for u in [
+                [0.5, 0.5, 0.3],
+                [0.2, 0.7, 0.9],
+                [0.9, 0.1, 0.6],
+                [0.0, 1.0, 0.5],
+            ] {
+                let q = sample_q(&leg, u);
+                let f = leg.link_frames(q);
+                let (mut pos, mut r) = ([0.0; 3], crate::kinematics::math::IDENTITY);
+                for (k, &angle) in q.iter().enumerate() {
+                    let placed = mat_mul(&r, &quat_to_mat(p.body_quat[k]));
+                    let origin = add(pos, mat_vec(&r, p.body_pos[k]));
+                    let anchor = add(origin, mat_vec(&placed, p.anchor[k]));
+                    r = mat_mul(&placed, &rot(p.axis[k], angle));
+                    pos = sub(anchor, mat_vec(&r, p.anchor[k]));
+                    let close = |a: Vec3, b: Vec3| norm(sub(a, b)) < 1e-14;
+                    assert!(
+                        close(f.pos[k], pos) && close(f.anchor[k], anchor),
+                        "{k}: {f:?}"
+                    );
+                    assert!(close(f.axis[k], mat_vec(&placed, p.axis[k])), "{k}: {f:?}");
+                    assert_mat_close(&f.rot[k], &r, 1e-14);
+                }
+            }
+        }
     }
 
     #[test]

@@ -12,8 +12,8 @@ pub mod quadruped;
 pub mod support;
 
 pub use body_pose::{
-    com_support_step, obstacle_avoidance_step, point_pose_jacobians, reachability_step,
-    BodyPoseStep, CollisionPoint, PointPoseJacobians,
+    com_support_step, obstacle_avoidance_step, point_pose_jacobians, point_pose_jacobians_at,
+    reachability_step, BodyPoseStep, CollisionPoint, PointPoseJacobians,
 };
 pub use leg::{IkResult, LegChain, LegParams, LinkFrames, IK_TOLERANCE};
 pub use quadruped::{leg_q, BodyPose, Configuration, Quadruped, LEG_NAMES};

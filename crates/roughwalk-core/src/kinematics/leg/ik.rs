@@ -18,6 +18,14 @@ use crate::kinematics::math::{
 /// between axes that must be perpendicular, |sin| between axes that must be parallel.
 const STRUCTURE_TOLERANCE: f64 = 1e-6;
 
+/// Polishing Newton steps start only this close to the target [m]: a
+/// candidate of a chain within [`STRUCTURE_TOLERANCE`] of the analytic
+/// structure lands within about that times the leg's length of a target it
+/// can reach; one farther off is out of this candidate's reach, and the
+/// steps would only be wasted on it (the other candidates cover the other
+/// solutions).
+const NEWTON_RANGE: f64 = 1e-5;
+
 /// Targets farther than this from the hip [m] are pulled in along their direction
 /// before solving: no leg reaches that far, and it keeps squares finite.
 const FAR_TARGET: f64 = 1e3;
@@ -160,6 +168,13 @@ pub(super) fn wrap_into_limits(q: f64, lower: f64, upper: f64) -> Option<f64> {
     (v <= hi).then(|| v.clamp(lower, upper))
 }
 
+/// What the analytic IK found: a candidate that reaches the target, or the
+/// nearest one (error [m], q, frames) if it was asked for.
+enum Analytic {
+    Reached(IkResult, LinkFrames),
+    Nearest(Option<(f64, Vec3, LinkFrames)>),
+}
+
 /// The four solutions (2 HAA × 2 knee branches) of the limit-free chain,
 /// most preferred first: HAA nearest its nominal angle, then the knee branch
 /// `knee`. Every candidate is finite; out of reach they are only
@@ -184,7 +199,10 @@ impl AnalyticCandidates {
             .sqrt();
         let nominal_haa = leg.nominal()[0];
         let polar = t_w.atan2(t_n);
-        let mut haa = [v_w_abs, -v_w_abs].map(|v_w| (v_w, polar - v_w.atan2(g.lateral)));
+        // atan2 is odd in its first argument (IEEE sign symmetry, exactly):
+        // one call serves both solutions.
+        let turn = v_w_abs.atan2(g.lateral);
+        let mut haa = [(v_w_abs, polar - turn), (-v_w_abs, polar + turn)];
         if wrap_angle(haa[0].1 - nominal_haa).abs() > wrap_angle(haa[1].1 - nominal_haa).abs() {
             haa.swap(0, 1);
         }
@@ -287,25 +305,76 @@ impl LegChain {
         }
     }
 
+    /// [`Self::ik_with_frames`] where the analytic IK places the foot;
+    /// otherwise, instead of the closest-reachable search (tens of times
+    /// dearer), the analytic candidate whose joint angles, clamped into their
+    /// limits, put the foot nearest `target`: near the closest reachable foot
+    /// but not it (`reachable` false, `error` its distance [m]). For callers
+    /// that need only the direction and rough size of the foot's error, such
+    /// as the pose certificate's reachability step (Zucker 2011, §3.2).
+    pub fn ik_or_clamped(&self, target: Vec3, knee_sign: Option<f64>) -> (IkResult, LinkFrames) {
+        if !target.iter().all(|v| v.is_finite()) {
+            return self.ik_with_frames(target, knee_sign);
+        }
+        let solve_target = self.solve_target(target);
+        let (error, q, frames) = match self.analytic(solve_target, target, knee_sign, true) {
+            Analytic::Reached(result, frames) => return (result, frames),
+            Analytic::Nearest(nearest) => nearest.expect("four clamped candidates"),
+        };
+        let (lower, upper) = (self.params.lower, self.params.upper);
+        let on_limit =
+            (0..3).any(|k| q[k] <= lower[k] + LIMIT_SLACK || q[k] >= upper[k] - LIMIT_SLACK);
+        let reachable = error <= IK_TOLERANCE;
+        let result = IkResult {
+            q,
+            reachable,
+            within_limits: reachable || !on_limit,
+            error,
+        };
+        (result, frames)
+    }
+
+    /// The knee branch to prefer, ±1.
+    fn knee(&self, knee_sign: Option<f64>) -> f64 {
+        if knee_sign.unwrap_or(self.params.knee_sign) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+
     fn ik_exact_at(
         &self,
         solve_target: Vec3,
         target: Vec3,
         knee_sign: Option<f64>,
     ) -> Option<(IkResult, LinkFrames)> {
-        let knee = if knee_sign.unwrap_or(self.params.knee_sign) < 0.0 {
-            -1.0
-        } else {
-            1.0
-        };
+        match self.analytic(solve_target, target, knee_sign, false) {
+            Analytic::Reached(result, frames) => Some((result, frames)),
+            Analytic::Nearest(_) => None,
+        }
+    }
+
+    /// The first analytic candidate, in order of preference, that reaches
+    /// `target` within the joint limits; otherwise, with `nearest`, the
+    /// candidate (clamped into the limits where it leaves them) whose foot
+    /// is nearest, as (error [m], q, frames).
+    fn analytic(
+        &self,
+        solve_target: Vec3,
+        target: Vec3,
+        knee_sign: Option<f64>,
+        nearest: bool,
+    ) -> Analytic {
+        let (lower, upper) = (self.params.lower, self.params.upper);
         // Candidates are built one at a time: the first usually fits, and
         // each costs a handful of atan2/acos/sin_cos.
-        let candidates = AnalyticCandidates::new(self, solve_target, knee);
+        let candidates = AnalyticCandidates::new(self, solve_target, self.knee(knee_sign));
+        let mut best: Option<(f64, Vec3, LinkFrames)> = None;
         for k in 0..4 {
             let q = candidates.get(self, k);
-            let wrapped = [0, 1, 2]
-                .map(|k| wrap_into_limits(q[k], self.params.lower[k], self.params.upper[k]));
-            if let [Some(a), Some(b), Some(c)] = wrapped {
+            let wrapped = [0, 1, 2].map(|k| wrap_into_limits(q[k], lower[k], upper[k]));
+            let (q, error, frames) = if let [Some(a), Some(b), Some(c)] = wrapped {
                 let (q, error, frames) = self.polish([a, b, c], target);
                 if error <= IK_TOLERANCE {
                     let result = IkResult {
@@ -314,11 +383,26 @@ impl LegChain {
                         within_limits: true,
                         error,
                     };
-                    return Some((result, frames));
+                    return Analytic::Reached(result, frames);
                 }
+                (q, error, frames)
+            } else if nearest {
+                let q = [0, 1, 2].map(|j| {
+                    wrapped[j].unwrap_or_else(|| wrap_angle(q[j]).clamp(lower[j], upper[j]))
+                });
+                let frames = self.link_frames(q);
+                let foot = add(frames.pos[2], mat_vec(&frames.rot[2], self.params.foot));
+                (q, norm(sub(foot, target)), frames)
+            } else {
+                continue;
+            };
+            match best {
+                Some((e, _, _)) if e <= error => {}
+                _ if nearest => best = Some((error, q, frames)),
+                _ => {}
             }
         }
-        None
+        Analytic::Nearest(best)
     }
 
     /// The target relative to the HAA anchor, in the hip frame at q_HAA = 0 [m].
@@ -339,7 +423,7 @@ impl LegChain {
         let (mut q, (mut foot, mut frames)) = (q, fk(q));
         let mut error = norm(sub(foot, target));
         for _ in 0..4 {
-            if error <= 1e-14 {
+            if error <= 1e-14 || error > NEWTON_RANGE {
                 break;
             }
             let jacobian = Self::columns(&frames, foot, 2);
@@ -477,6 +561,18 @@ mod tests {
                 }
                 None => prop_assert!(!r.reachable, "{r:?}"),
             }
+            // The cheap variant: the same where the analytic IK reaches; else
+            // within limits, its frames and error consistent, never nearer
+            // than the closest reachable foot, which it approximates.
+            let (c, frames) = leg.ik_or_clamped(target, None);
+            prop_assert_eq!(frames, leg.link_frames(c.q));
+            if let Some((exact, _)) = leg.ik_exact(target, None) {
+                prop_assert_eq!(c, exact);
+            } else {
+                prop_assert!(!c.reachable && leg.is_within_limits(c.q), "{c:?}");
+                prop_assert!((norm(sub(leg.fk(c.q), target)) - c.error).abs() < 1e-12);
+                prop_assert!(c.error >= r.error - 1e-9, "{c:?} vs closest {r:?}");
+            }
         }
     }
 
@@ -488,5 +584,6 @@ mod tests {
         let (r, frames) = leg.ik_with_frames([f64::NAN, 0.0, 0.0], None);
         assert_eq!(frames, leg.link_frames(r.q));
         assert!(!r.reachable);
+        assert_eq!(leg.ik_or_clamped([f64::NAN, 0.0, 0.0], None), (r, frames));
     }
 }

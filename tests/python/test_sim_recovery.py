@@ -1,0 +1,60 @@
+"""The reflex's recovery motion: where the lifted feet go down."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import roughwalk
+from roughwalk.sim.recovery import recovery_segment
+from roughwalk.sim.runner import Runner
+from roughwalk.sim.world import World
+
+
+@pytest.fixture(scope="module")
+def standing() -> tuple[roughwalk.Robot, roughwalk.Terrain, object]:
+    robot = roughwalk.load_robot("littledog")
+    terrain = roughwalk.load_terrain("flat")
+    st = robot.nominal_stance
+    base = np.array([0.5, 0.0, st.base_height])
+    q, _ = robot.inverse_kinematics(st.feet + base, base, np.array([1.0, 0.0, 0.0, 0.0]))
+    measured = Runner(World(robot, terrain)).reset(q, base, np.array([1.0, 0.0, 0.0, 0.0]))
+    return robot, terrain, measured
+
+
+def footholds(standing, velocity, capture_max_m: float = 0.04) -> np.ndarray:
+    """Where recovery puts the feet of the robot moving at ``velocity`` [m/s], LH lifted."""
+    robot, terrain, measured = standing
+    moving = dataclasses.replace(measured, base_vel=np.asarray(velocity, dtype=float))
+    lifted = np.array([True, True, False, True])  # LH in the air
+    _, feet = recovery_segment(
+        robot, terrain, moving, measured.feet, lifted, 0.5, 0.3, 0.0, capture_max_m=capture_max_m
+    )
+    return feet
+
+
+def test_a_lifted_foot_goes_down_straight_when_the_trunk_is_still(standing) -> None:
+    _, _, measured = standing
+    feet = footholds(standing, [0.0, 0.0, 0.0])
+    np.testing.assert_allclose(feet[:, :2], measured.feet[:, :2], atol=1e-12)
+
+
+def test_a_trunk_heading_for_the_lifted_foot_moves_it_to_the_capture_point(standing) -> None:
+    robot, _, measured = standing
+    # Pushed to the left (+y), LH lifted: LH goes down v·√(h/g) further left.
+    h = measured.base_pos[2] - measured.feet[:, 2].mean()
+    feet = footholds(standing, [0.0, 0.2, 0.0])
+    np.testing.assert_allclose(feet[2, :2] - measured.feet[2, :2], [0.0, 0.2 * np.sqrt(h / 9.81)])
+    assert feet[2, 2] == pytest.approx(robot.foot_radius, abs=1e-3)  # on the ground
+    np.testing.assert_allclose(feet[[0, 1, 3]], measured.feet[[0, 1, 3]])  # the others stay
+    # A harder push: the step is bounded.
+    far = footholds(standing, [0.0, 2.0, 0.0])
+    assert np.linalg.norm(far[2, :2] - measured.feet[2, :2]) == pytest.approx(0.04)
+    # Moving away from the lifted foot's side: no step inwards.
+    away = footholds(standing, [0.0, -0.2, 0.0])
+    np.testing.assert_allclose(away[2, :2], measured.feet[2, :2], atol=1e-12)
+    # Capture off: straight down.
+    off = footholds(standing, [0.0, 0.2, 0.0], capture_max_m=0.0)
+    np.testing.assert_allclose(off[2, :2], measured.feet[2, :2], atol=1e-12)
