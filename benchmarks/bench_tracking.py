@@ -139,7 +139,7 @@ def run_job(job: Job) -> dict[str, Any]:
         "index": job.index,
         "start": list(job.start),
     }
-    started = time.perf_counter()
+    started, started_cpu = time.perf_counter(), time.process_time()
     try:
         result = optimize_motion(
             robot,
@@ -177,6 +177,7 @@ def run_job(job: Job) -> dict[str, Any]:
         fell=outcome.fell,
         tick_cpu_ms=_finite(outcome.mean_tick_cpu_ms),
         time_s=time.perf_counter() - started,
+        cpu_s=time.process_time() - started_cpu,
     )
     return row
 
@@ -369,6 +370,7 @@ def _progress(row: dict[str, Any]) -> str:
         f"{row['env']} {row['init']} {kind} iters={row['max_iter']} task {row['index']}: "
         f"{row.get('solve_status', '-')} in {row.get('iterations', '-')} iterations; "
         f"{'success' if row.get('success') else 'failure'}: {row.get('reason', '')}"
+        f" ({row.get('cpu_s', 0.0):.0f} s CPU)"
     )
 
 
