@@ -139,7 +139,7 @@ def run_job(job: Job) -> dict[str, Any]:
         "index": job.index,
         "start": list(job.start),
     }
-    started = time.perf_counter()
+    started, started_cpu = time.perf_counter(), time.process_time()
     try:
         result = optimize_motion(
             robot,
@@ -166,17 +166,24 @@ def run_job(job: Job) -> dict[str, Any]:
     except Exception as e:  # noqa: BLE001
         row.update(success=False, reason=f"execution raised {type(e).__name__}: {e}")
         return row
+    # A motion whose first pose is out of reach never starts: its errors are
+    # NaN, which JSON cannot hold (the whole run's file used to fail on it).
     row.update(
         success=outcome.success,
         reason=outcome.reason,
-        mean_position_error_m=outcome.mean_position_error_m,
-        final_position_error_m=outcome.final_position_error_m,
-        max_orientation_error_rad=outcome.max_orientation_error_rad,
+        mean_position_error_m=_finite(outcome.mean_position_error_m),
+        final_position_error_m=_finite(outcome.final_position_error_m),
+        max_orientation_error_rad=_finite(outcome.max_orientation_error_rad),
         fell=outcome.fell,
-        tick_cpu_ms=outcome.mean_tick_cpu_ms,
+        tick_cpu_ms=_finite(outcome.mean_tick_cpu_ms),
         time_s=time.perf_counter() - started,
+        cpu_s=time.process_time() - started_cpu,
     )
     return row
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
 
 
 def _executor(name: str, workers: int, address: str | None) -> Any:
@@ -195,8 +202,10 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
         groups.setdefault(key, []).append(r)
     out = []
     for (env, init, opt, it), rs in sorted(groups.items(), key=lambda kv: str(kv[0])):
-        errors = [r["mean_position_error_m"] for r in rs if "mean_position_error_m" in r]
-        ticks = [r["tick_cpu_ms"] for r in rs if "tick_cpu_ms" in r]
+        errors = [
+            r["mean_position_error_m"] for r in rs if r.get("mean_position_error_m") is not None
+        ]
+        ticks = [r["tick_cpu_ms"] for r in rs if r.get("tick_cpu_ms") is not None]
         out.append(
             {
                 "env": env,
@@ -314,32 +323,55 @@ def main() -> None:
                 for it in iters:
                     for i, t in enumerate(tasks):
                         jobs.append(Job(env, terrain, init, it, opt, i, t.start, t.goal))
-    print(f"{len(jobs)} solve-and-execute jobs ...")
+    print(f"{len(jobs)} solve-and-execute jobs ...", flush=True)
     executor = _executor(args.executor, args.workers, args.address)
     started = time.perf_counter()
-    rows = list(executor.run(run_job, jobs)) if executor else [run_job(j) for j in jobs]
-    elapsed = time.perf_counter() - started
+
+    def save(rows: list[dict[str, Any]], fig4: list[dict[str, Any]], complete: bool) -> None:
+        write_json(
+            args.json,
+            result_envelope(
+                "bench_tracking",
+                robot="anymal_c",
+                machine=machine_description(),
+                tasks_per_point=n,
+                gait=GAIT,
+                steps=STEPS,
+                duration=DURATION,
+                notes=notes,
+                complete=complete,
+                jobs=len(jobs),
+                wall_time_s=time.perf_counter() - started,
+                summary=summarise(rows),
+                runs=rows,
+                figure4=fig4,
+            ),
+        )
+
+    # Each finished job is printed and saved at once: a long run that is
+    # killed keeps what it measured (the file says complete: false).
+    rows: list[dict[str, Any]] = []
+    results = executor.run(run_job, jobs) if executor else map(run_job, jobs)
+    for row in results:
+        rows.append(row)
+        print(f"[{len(rows)}/{len(jobs)}] {_progress(row)}", flush=True)
+        save(rows, [], complete=False)
     summary = summarise(rows)
     print_table(summary)
     fig4 = figure4(args.json.parent) if args.figure4 else []
-    write_json(
-        args.json,
-        result_envelope(
-            "bench_tracking",
-            robot="anymal_c",
-            machine=machine_description(),
-            tasks_per_point=n,
-            gait=GAIT,
-            steps=STEPS,
-            duration=DURATION,
-            notes=notes,
-            wall_time_s=elapsed,
-            summary=summary,
-            runs=rows,
-            figure4=fig4,
-        ),
+    save(rows, fig4, complete=True)
+    print(f"wrote {args.json} ({time.perf_counter() - started:.0f} s)")
+
+
+def _progress(row: dict[str, Any]) -> str:
+    """One job's line: which point, solved how, tracked how."""
+    kind = "optimised" if row["optimize_durations"] else "fixed"
+    return (
+        f"{row['env']} {row['init']} {kind} iters={row['max_iter']} task {row['index']}: "
+        f"{row.get('solve_status', '-')} in {row.get('iterations', '-')} iterations; "
+        f"{'success' if row.get('success') else 'failure'}: {row.get('reason', '')}"
+        f" ({row.get('cpu_s', 0.0):.0f} s CPU)"
     )
-    print(f"wrote {args.json} ({elapsed:.0f} s)")
 
 
 if __name__ == "__main__":

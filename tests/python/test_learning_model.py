@@ -109,3 +109,19 @@ def test_g_max_is_found_at_the_start_of_the_tail() -> None:
     result = filter_good(Dataset(columns, {}))
     assert result.automatic and result.n_good == len(body) - 1
     assert filter_good(Dataset(columns, {}), g_max=10.0).n_good == len(body) - 1 + 1
+
+
+def test_multipliers_of_a_constraint_added_after_training_start_at_zero() -> None:
+    """A model's lam_g stays the prefix of a problem that gained rows at the end; else untouched."""
+    from types import SimpleNamespace
+
+    from roughwalk.learning.initializer import _complete_rows
+
+    rows = [SimpleNamespace(size=n) for n in (5, 3, 4)]
+    nlp = SimpleNamespace(rows=rows, n_constraints=12)
+    lam = np.arange(1.0, 9.0)  # the first two blocks: 8 rows
+    completed = _complete_rows(nlp, lam)  # type: ignore[arg-type]
+    np.testing.assert_array_equal(completed, np.concatenate([lam, np.zeros(4)]))
+    # Not on a block boundary: left as it is, so the solver drops the mismatched multipliers.
+    assert _complete_rows(nlp, lam[:7]).size == 7  # type: ignore[arg-type]
+    assert _complete_rows(nlp, np.ones(12)).size == 12  # type: ignore[arg-type]

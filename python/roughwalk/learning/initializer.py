@@ -114,7 +114,25 @@ class LearnedInitializer:
         lam_x, lam_g = self.model.predict_multipliers([task.task])
         if lam_x is None or lam_g is None:
             return None, None
-        return lam_x[0], lam_g[0]
+        return lam_x[0], _complete_rows(nlp, lam_g[0])
+
+
+def _complete_rows(nlp: Formulation, lam_g: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``lam_g`` for every row of ``nlp``: zeros for constraints appended after the model's.
+
+    Constraints are stacked in the config's order, so a problem that gained a
+    constraint at the end (``leg_reach``) keeps the model's rows as its
+    prefix; the new rows start inactive (multiplier 0) rather than losing
+    the whole warm start. Returned unchanged when the prefix does not end on
+    a constraint block's boundary (the solver then drops the multipliers).
+    """
+    n = lam_g.size
+    if n >= nlp.n_constraints:
+        return lam_g
+    ends = np.cumsum([rows.size for rows in nlp.rows])
+    if n not in ends:
+        return lam_g
+    return np.concatenate([lam_g, np.zeros(nlp.n_constraints - n)])
 
 
 register_initializer("learned", LearnedInitializer)

@@ -48,8 +48,10 @@ MELON_CONSTRAINTS: tuple[str, ...] = (
     "base_above_feet",
     "swing_height",
     "swing_apex",
+    "leg_reach",
 )
-"""TOWR's constraints plus Melon et al.'s base-above-feet and swing-height ones and a swing apex."""
+"""TOWR's constraints plus Melon et al.'s base-above-feet and swing-height ones, a swing apex
+and the legs' real reach (a ball per leg, for bodies that know it)."""
 
 
 @dataclass(frozen=True)

@@ -337,6 +337,10 @@ class TrajoptResult:
                     force_limit=float(body["force_limit"]),
                     friction=float(body["friction"]),
                     com_in_base=tuple(body.get("com_in_base", (0.0, 0.0, 0.0))),
+                    reach_centres=None
+                    if body.get("reach_centres") is None
+                    else tuple(tuple(r) for r in body["reach_centres"]),  # type: ignore[arg-type]
+                    reach_radius=body.get("reach_radius"),
                 )
                 if body
                 else None,

@@ -61,6 +61,12 @@ class SingleRigidBody:
     com_in_base:
         (3,) the centre of mass in the robot's base frame [m]: add
         −R·com_in_base to a planned CoM to get the base frame's origin.
+    reach_centres, reach_radius:
+        The legs' reach, when known: each foot contact point i lies within
+        ``reach_radius`` [m] of ``reach_centres[i]`` (4, 3) [m] (base axes,
+        relative to the centre of mass). The box alone cannot say this: its
+        lower corners lie beyond a real leg's stretch (see
+        :func:`leg_reach_sphere`). None (TOWR's model) means the box only.
 
     """
 
@@ -72,6 +78,8 @@ class SingleRigidBody:
     force_limit: float = 1000.0
     friction: float = 0.5
     com_in_base: Vec3 = (0.0, 0.0, 0.0)
+    reach_centres: tuple[Vec3, Vec3, Vec3, Vec3] | None = None
+    reach_radius: float | None = None
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.mass) and self.mass > 0):
@@ -93,6 +101,14 @@ class SingleRigidBody:
             raise InvalidArgumentError(
                 f"force_limit and friction must be > 0, got {self.force_limit}, {self.friction}"
             )
+        if (self.reach_centres is None) != (self.reach_radius is None):
+            raise InvalidArgumentError("reach_centres and reach_radius come together or not at all")
+        if self.reach_centres is not None:
+            if np.asarray(self.reach_centres).shape != (4, 3):
+                raise InvalidArgumentError("reach_centres must hold 4 points of (x, y, z) [m]")
+            radius = self.reach_radius
+            if radius is None or not (np.isfinite(radius) and radius > 0):
+                raise InvalidArgumentError(f"reach_radius must be > 0 m, got {radius}")
 
     @property
     def inertia_matrix(self) -> NDArray[np.float64]:
@@ -129,6 +145,10 @@ class SingleRigidBody:
             "force_limit": self.force_limit,
             "friction": self.friction,
             "com_in_base": list(self.com_in_base),
+            "reach_centres": None
+            if self.reach_centres is None
+            else [list(r) for r in self.reach_centres],
+            "reach_radius": self.reach_radius,
         }
 
 
@@ -190,6 +210,38 @@ def _composite_inertia(robot: Robot) -> tuple[NDArray[np.float64], NDArray[np.fl
     return com, 0.5 * (total + total.T)
 
 
+def leg_reach_sphere(
+    robot: Robot, min_knee_bend_rad: float = 0.35
+) -> tuple[NDArray[np.float64], float] | None:
+    """Sphere centres (4, 3) in the base frame [m] and radius [m] holding each leg's foot centres.
+
+    For an abduction–flexion–knee leg (HAA about base x, HFE and KFE about
+    base y), a foot centre lies at a fixed lateral offset l from the HAA axis
+    and, in the thigh–shank plane, at r = √(a² + b² + 2ab cos φ) from the HFE
+    joint (thigh a, shank b, knee bend φ; 0 is straight). With v the foot
+    relative to the HAA anchor and h_x the HFE joint's offset along x,
+    r² = (v_x − h_x)² + v_y² + v_z² − l², so r ≤ r(φ_min) is the ball
+    |v − h_x e_x| ≤ √(r(φ_min)² + l²): a smooth constraint for the NLP.
+    ``min_knee_bend_rad`` keeps the knee that far from straight, where a
+    whole-body controller loses the leg (the tracking wing's ``LegReach``
+    uses the same margin). None when a leg is not of that kind.
+    """
+    legs = robot.description.legs
+    for leg in legs:
+        axes = np.abs(np.asarray(leg.axis, dtype=float))
+        turned = any(not np.allclose(np.abs(q), [1, 0, 0, 0]) for q in leg.body_quat)
+        if turned or not np.allclose(axes, [[1, 0, 0], [0, 1, 0], [0, 1, 0]], atol=1e-6):
+            return None
+    haa = np.array([np.asarray(leg.body_pos[0]) + leg.anchor[0] for leg in legs])
+    hfe_x = np.array([leg.body_pos[1][0] + leg.anchor[1][0] for leg in legs])
+    lateral = np.array([leg.body_pos[1][1] + leg.body_pos[2][1] + leg.foot[1] for leg in legs])
+    a, b = robot.leg_lengths[:, 0], robot.leg_lengths[:, 1]
+    reach = np.sqrt(a * a + b * b + 2 * a * b * np.cos(min_knee_bend_rad))
+    radius = np.sqrt(reach**2 + lateral**2)
+    centres = haa + np.outer(hfe_x, [1.0, 0.0, 0.0])
+    return centres, float(radius.min())
+
+
 def rigid_body_from_robot(robot: Robot, **overrides: object) -> SingleRigidBody:
     """The single rigid body of ``robot`` at its nominal pose; ``overrides`` replace fields.
 
@@ -197,13 +249,20 @@ def rigid_body_from_robot(robot: Robot, **overrides: object) -> SingleRigidBody:
     mass; the nominal stance is the feet's contact points (foot centres
     lowered by the foot radius) relative to that centre of mass; the
     range-of-motion box and force limit scale TOWR's ANYmal values by leg
-    length and weight.
+    length and weight, and the legs' reach ball (:func:`leg_reach_sphere`)
+    cuts off the box's corners the legs cannot reach.
     """
     com, inertia = _composite_inertia(robot)
     feet = np.asarray(robot.nominal_stance.feet, dtype=float) - com
     feet[:, 2] -= robot.foot_radius
     leg_length = float(np.mean(robot.leg_lengths.sum(axis=1)))
     box = _BOX_PER_LEG_LENGTH * leg_length
+    sphere = leg_reach_sphere(robot)
+    centres: tuple[Vec3, Vec3, Vec3, Vec3] | None = None
+    if sphere is not None:
+        # Centres for contact points relative to the CoM (foot centre = contact + r_foot e_z).
+        o = sphere[0] - com - np.array([0.0, 0.0, robot.foot_radius])
+        centres = (_tuple3(o[0]), _tuple3(o[1]), _tuple3(o[2]), _tuple3(o[3]))
     body = SingleRigidBody(
         name=robot.name,
         mass=float(robot.mass),
@@ -213,6 +272,8 @@ def rigid_body_from_robot(robot: Robot, **overrides: object) -> SingleRigidBody:
         force_limit=float(_FORCE_LIMIT_PER_WEIGHT * robot.mass * GRAVITY),
         friction=0.5,
         com_in_base=_tuple3(com),
+        reach_centres=centres,
+        reach_radius=None if sphere is None else sphere[1],
     )
     return body.with_changes(**overrides) if overrides else body
 
