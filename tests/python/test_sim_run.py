@@ -11,7 +11,7 @@ import pytest
 import roughwalk
 from roughwalk import _core
 from roughwalk.sim import CrawlSource, Push, RunLog, RunResult, run
-from roughwalk.sim.footstep_source import FootstepSource, PlannerSource
+from roughwalk.sim.footstep_source import FootstepSource, PlanAttempt, PlannerSource, PlanStart
 
 HAVE_PLANNER = hasattr(_core, "FootstepPlanner")
 
@@ -115,6 +115,56 @@ def test_one_reflex_rescues_a_push_to_the_right_mid_stride(littledog, at_s: floa
     result = walk(littledog, terrain, disturbances=[push])
     assert result.outcome.reflexes == 1 and result.outcome.replans == 1
     assert_walked_to_goal(result)
+
+
+class StopsInsideGoalRadius:
+    """Plans as :func:`source`, but a re-plan from feet within ``radius`` [m] of the goal
+    returns the stance alone: what the planner returns from inside its goal radius."""
+
+    name = "planner"
+
+    def __init__(self, robot: roughwalk.Robot, terrain: roughwalk.Terrain, radius: float) -> None:
+        self.inner = source(robot, terrain)
+        self.robot = robot
+        self.radius = radius
+        self.stances = 0
+
+    def plan(self, start: PlanStart, goal: np.ndarray, time_limit: float) -> PlanAttempt:
+        feet = start.feet
+        if feet is None or np.linalg.norm(feet[:, :2].mean(axis=0) - goal) > self.radius:
+            return self.inner.plan(start, goal, time_limit)
+        self.stances += 1
+        legs = ("LF", "RF", "LH", "RH")
+        r = self.robot.foot_radius
+        stance = [
+            {"leg": leg, "x": float(f[0]), "y": float(f[1]), "z": float(f[2] - r)}
+            for leg, f in zip(legs, feet, strict=True)
+        ]
+        return PlanAttempt({"footsteps": stance, "certificates": []}, "EXACT", "", 0.0)
+
+
+def test_a_replan_from_inside_the_goal_radius_ends_the_run_at_the_goal(littledog) -> None:
+    # A re-plan whose start was already inside the planner's goal radius got
+    # the stance alone back, and the run failed: "a footstep plan needs the
+    # 4 feet of its initial stance and at least one step; got 4 footsteps".
+    # A wide goal (0.48 m) puts the robot inside it when the push comes.
+    terrain = roughwalk.load_terrain("flat")
+    planner = StopsInsideGoalRadius(littledog, terrain, radius=0.48)
+    result = run(
+        littledog,
+        terrain,
+        (0.25, 0.0, 0.0),
+        (0.75, 0.0),
+        planner=planner,
+        disturbances=[Push(impulse_ns=1.0, at_s=2.0)],
+        **{"executor.compute_time_scale": 0.0, "outcome.goal_radius_m": 0.48},
+    )
+    o = result.outcome
+    assert planner.stances == 1 and o.replans == 1
+    assert o.success and o.reason == "reached the goal"
+    # No step was taken after the re-plan: the run ended where it stood.
+    kinds = [e["kind"] for e in result.log.events]
+    assert "step" not in kinds[kinds.index("replan") :]
 
 
 def test_a_fall_is_a_failure_with_its_reason(littledog) -> None:
