@@ -102,17 +102,28 @@ def test_a_push_beyond_the_threshold_triggers_a_reflex_and_a_replan(littledog) -
     assert blind.outcome.reflexes == 0 and blind.outcome.replans == 0
 
 
-@pytest.mark.parametrize("at_s", [2.0, 2.6])
-def test_one_reflex_rescues_a_push_to_the_right_mid_stride(littledog, at_s: float) -> None:
-    # Pushed right at 2 s (RF about to lift), the robot once went through
-    # five reflexes and fell: the recovery's trunk twisted 12° off its target
-    # yaw, so the re-plan's blend began with an orientation error that fired
-    # the next reflex at once, and each re-plan started from a worse stance.
-    # At 2.6 s the trunk still rocked when the timed hold ended, and the
-    # re-plan's first step, lifting RF, tipped it over.
+@pytest.mark.parametrize(("law", "at_s"), [("knots", 2.0), ("knots", 2.6), ("even", 2.2)])
+def test_one_reflex_rescues_a_push_to_the_right_mid_stride(
+    littledog, law: str, at_s: float
+) -> None:
+    # With the "knots" swing timing (the default until session 4, whose
+    # gait phases these times name): pushed right at 2 s (RF about to lift),
+    # the robot once went through five reflexes and fell: the recovery's
+    # trunk twisted 12° off its target yaw, so the re-plan's blend began
+    # with an orientation error that fired the next reflex at once, and
+    # each re-plan started from a worse stance. At 2.6 s the trunk still
+    # rocked when the timed hold ended, and the re-plan's first step,
+    # lifting RF, tipped it over. The "even" timing's shorter swings put
+    # 2.0 s where the push fires no reflex; at 2.2 s it does.
+    timing = {"swing.time_law": law, "swing.lift_fraction": 0.1 if law == "knots" else 0.3}
     terrain = roughwalk.load_terrain("flat")
     push = Push(impulse_ns=1.0, at_s=at_s, direction_deg=-90.0)
-    result = walk(littledog, terrain, disturbances=[push])
+    result = walk(
+        littledog,
+        terrain,
+        disturbances=[push],
+        trajectory_config=roughwalk.trajectories.trajectory_config(**timing),
+    )
     assert result.outcome.reflexes == 1 and result.outcome.replans == 1
     assert_walked_to_goal(result)
 
