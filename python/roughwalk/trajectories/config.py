@@ -163,10 +163,11 @@ class SwingConfig:
         executor.compute_time_scale=0``, seeds 0–1), "knots" → "even":
         swings 0.42–0.64 → 0.30–0.36 s; barrier 3.07 → 4.16 cm/s, steps
         3.01 → 3.98, round rocks 2.60 → 3.21 (the same runs succeed: 2/2,
-        2/2, 1/2; sloped rocks 2/2 at 2.64 → 3.57; large rocks 0/2 with
-        both). Under a 1 N·s side push on flat ground (``roughwalk bench
-        push_recovery``, 17 push times from 1.6 to 4.8 s) "knots" survives
-        16 to the left and 12 to the right, "even" 16 and 15; the falls
+        2/2, 1/2; sloped rocks 2/2 at 2.64 → 3.57; gap 0/2 → 1/2 at 3.71;
+        large rocks and logs 0/2 with both). Under a 1 N·s side push on
+        flat ground (``roughwalk bench push_recovery``, 17 push times from
+        1.6 to 4.8 s) "knots" survives 16 to the left and 12 to the right,
+        "even" 16 and 15; the falls
         looked at are of one kind with both (pushed while a foot of the
         other side swings, the trunk rolls over the feet it is pushed
         towards), and the sweep's default 1.6–3.2 s window misses those of
