@@ -12,8 +12,10 @@ motion, and reports per push time whether the robot reached the goal, and
 its reflexes and re-plans.
 
 Run: ``roughwalk bench push_recovery [--impulse 1.0] [--direction 90]
-[--from 1.6] [--to 3.2] [--step 0.2] [--terrain flat] [--set KEY=VALUE ...]``. Writes
-``benchmarks/results/push_recovery.json``.
+[--from 1.6] [--to 3.2] [--step 0.2] [--terrain flat] [--set KEY=VALUE ...]``;
+``--set`` overrides a simulation setting or, prefixed ``trajectory.``, a
+setting of trajectory generation (``trajectory.swing.time_law=even``), as
+in ``roughwalk bench littledog``. Writes ``benchmarks/results/push_recovery.json``.
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ def push_run(
     impulse: float,
     direction: float,
     sets: dict[str, Any],
+    trajectory_config: Any = None,
 ) -> dict[str, Any]:
     """One walk with a push at ``at_s`` [s] after the first motion; its outcome and events."""
     began = time.process_time()
@@ -52,6 +55,7 @@ def push_run(
         START,
         GOAL,
         planner=source,
+        trajectory_config=trajectory_config,
         disturbances=[Push(impulse_ns=impulse, at_s=at_s, direction_deg=direction)],
         **{"executor.compute_time_scale": 0.0, **sets},
     )
@@ -87,13 +91,26 @@ def main(argv: list[str] | None = None) -> int:
         metavar="KEY=VALUE",
         action="append",
         default=[],
-        help="override a simulation setting (repeatable, dotted keys)",
+        help="override a simulation setting, or with a 'trajectory.' prefix a trajectory "
+        "setting (repeatable, dotted keys)",
     )
     args = ap.parse_args(argv)
     sets: dict[str, Any] = {}
+    traj: dict[str, Any] = {}
     for item in args.set:
-        key, _, value = item.partition("=")
-        sets[key] = value
+        key, eq, value = item.partition("=")
+        key = key.strip()
+        if not eq or not key:
+            ap.error(f"--set takes KEY=VALUE, got {item!r}")
+        if key.startswith("trajectory."):
+            traj[key.removeprefix("trajectory.")] = value.strip()
+        else:
+            sets[key] = value.strip()
+    try:
+        rw.sim.sim_config(**sets)
+        trajectory_config = rw.trajectories.trajectory_config(**traj) if traj else None
+    except rw.ConfigError as e:
+        ap.error(str(e))
     robot = rw.load_robot("littledog")
     terrain = rw.load_terrain(args.terrain)
     source = PlannerSource(robot, terrain, expansions=args.expansions)
@@ -101,7 +118,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{'push [s]':>8} {'ok':>4} {'reflexes':>8} {'replans':>7}  reason", flush=True)
     runs = []
     for at in times:
-        r = push_run(robot, terrain, source, float(at), args.impulse, args.direction, sets)
+        r = push_run(
+            robot, terrain, source, float(at), args.impulse, args.direction, sets, trajectory_config
+        )
         runs.append(r)
         print(
             f"{r['push_s']:>8.2f} {'yes' if r['success'] else 'no':>4} {r['reflexes']:>8} "
@@ -118,7 +137,7 @@ def main(argv: list[str] | None = None) -> int:
         impulse_ns=args.impulse,
         direction_deg=args.direction,
         expansions=args.expansions,
-        set=sets,
+        set={**sets, **{f"trajectory.{k}": v for k, v in traj.items()}},
         survived=survived,
         runs=runs,
     )

@@ -11,7 +11,7 @@ import pytest
 import roughwalk
 from roughwalk import _core
 from roughwalk.sim import CrawlSource, Push, RunLog, RunResult, run
-from roughwalk.sim.footstep_source import FootstepSource, PlannerSource
+from roughwalk.sim.footstep_source import FootstepSource, PlanAttempt, PlannerSource, PlanStart
 
 HAVE_PLANNER = hasattr(_core, "FootstepPlanner")
 
@@ -102,19 +102,80 @@ def test_a_push_beyond_the_threshold_triggers_a_reflex_and_a_replan(littledog) -
     assert blind.outcome.reflexes == 0 and blind.outcome.replans == 0
 
 
-@pytest.mark.parametrize("at_s", [2.0, 2.6])
-def test_one_reflex_rescues_a_push_to_the_right_mid_stride(littledog, at_s: float) -> None:
-    # Pushed right at 2 s (RF about to lift), the robot once went through
-    # five reflexes and fell: the recovery's trunk twisted 12° off its target
-    # yaw, so the re-plan's blend began with an orientation error that fired
-    # the next reflex at once, and each re-plan started from a worse stance.
-    # At 2.6 s the trunk still rocked when the timed hold ended, and the
-    # re-plan's first step, lifting RF, tipped it over.
+@pytest.mark.parametrize(("law", "at_s"), [("knots", 2.0), ("knots", 2.6), ("even", 2.2)])
+def test_one_reflex_rescues_a_push_to_the_right_mid_stride(
+    littledog, law: str, at_s: float
+) -> None:
+    # With the "knots" swing timing (the default until session 4, whose
+    # gait phases these times name): pushed right at 2 s (RF about to lift),
+    # the robot once went through five reflexes and fell: the recovery's
+    # trunk twisted 12° off its target yaw, so the re-plan's blend began
+    # with an orientation error that fired the next reflex at once, and
+    # each re-plan started from a worse stance. At 2.6 s the trunk still
+    # rocked when the timed hold ended, and the re-plan's first step,
+    # lifting RF, tipped it over. The "even" timing's shorter swings put
+    # 2.0 s where the push fires no reflex; at 2.2 s it does.
+    timing = {"swing.time_law": law, "swing.lift_fraction": 0.1 if law == "knots" else 0.3}
     terrain = roughwalk.load_terrain("flat")
     push = Push(impulse_ns=1.0, at_s=at_s, direction_deg=-90.0)
-    result = walk(littledog, terrain, disturbances=[push])
+    result = walk(
+        littledog,
+        terrain,
+        disturbances=[push],
+        trajectory_config=roughwalk.trajectories.trajectory_config(**timing),
+    )
     assert result.outcome.reflexes == 1 and result.outcome.replans == 1
     assert_walked_to_goal(result)
+
+
+class StopsInsideGoalRadius:
+    """Plans as :func:`source`, but a re-plan from feet within ``radius`` [m] of the goal
+    returns the stance alone: what the planner returns from inside its goal radius."""
+
+    name = "planner"
+
+    def __init__(self, robot: roughwalk.Robot, terrain: roughwalk.Terrain, radius: float) -> None:
+        self.inner = source(robot, terrain)
+        self.robot = robot
+        self.radius = radius
+        self.stances = 0
+
+    def plan(self, start: PlanStart, goal: np.ndarray, time_limit: float) -> PlanAttempt:
+        feet = start.feet
+        if feet is None or np.linalg.norm(feet[:, :2].mean(axis=0) - goal) > self.radius:
+            return self.inner.plan(start, goal, time_limit)
+        self.stances += 1
+        legs = ("LF", "RF", "LH", "RH")
+        r = self.robot.foot_radius
+        stance = [
+            {"leg": leg, "x": float(f[0]), "y": float(f[1]), "z": float(f[2] - r)}
+            for leg, f in zip(legs, feet, strict=True)
+        ]
+        return PlanAttempt({"footsteps": stance, "certificates": []}, "EXACT", "", 0.0)
+
+
+def test_a_replan_from_inside_the_goal_radius_ends_the_run_at_the_goal(littledog) -> None:
+    # A re-plan whose start was already inside the planner's goal radius got
+    # the stance alone back, and the run failed: "a footstep plan needs the
+    # 4 feet of its initial stance and at least one step; got 4 footsteps".
+    # A wide goal (0.48 m) puts the robot inside it when the push comes.
+    terrain = roughwalk.load_terrain("flat")
+    planner = StopsInsideGoalRadius(littledog, terrain, radius=0.48)
+    result = run(
+        littledog,
+        terrain,
+        (0.25, 0.0, 0.0),
+        (0.75, 0.0),
+        planner=planner,
+        disturbances=[Push(impulse_ns=1.0, at_s=2.0)],
+        **{"executor.compute_time_scale": 0.0, "outcome.goal_radius_m": 0.48},
+    )
+    o = result.outcome
+    assert planner.stances == 1 and o.replans == 1
+    assert o.success and o.reason == "reached the goal"
+    # No step was taken after the re-plan: the run ended where it stood.
+    kinds = [e["kind"] for e in result.log.events]
+    assert "step" not in kinds[kinds.index("replan") :]
 
 
 def test_a_fall_is_a_failure_with_its_reason(littledog) -> None:

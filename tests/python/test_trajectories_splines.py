@@ -153,12 +153,12 @@ def _littledog_swing_time(config: SwingConfig, stride: float) -> float:
 def test_even_time_law_lets_the_velocity_limits_allow_a_shorter_swing() -> None:
     # The same path re-timed to a steady speed: LittleDog's peak joint speeds
     # sit nearer their means, so the least duration (§5.2) drops; with
-    # rounder corners (lift_fraction 0.3), by a third or more against the
-    # defaults (knot timing, lift_fraction 0.1).
+    # rounder corners (lift_fraction 0.3), by a third or more against knot
+    # timing with lift_fraction 0.1 (the defaults until session 4).
     for stride in (0.06, 0.1):
         knots = _littledog_swing_time(SwingConfig(time_law="knots", lift_fraction=0.3), stride)
         even = _littledog_swing_time(SwingConfig(time_law="even", lift_fraction=0.3), stride)
-        before = _littledog_swing_time(SwingConfig(), stride)
+        before = _littledog_swing_time(SwingConfig(time_law="knots", lift_fraction=0.1), stride)
         assert even < 0.8 * knots, (stride, even, knots)
         assert even < 0.67 * before, (stride, even, before)
 

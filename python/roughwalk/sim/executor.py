@@ -44,6 +44,7 @@ from roughwalk.sim.trajectory_buffer import DesiredState, Segment, TrajectoryBuf
 from roughwalk.sim.world import World
 from roughwalk.trajectories.euler import matrix_to_rpy
 from roughwalk.trajectories.generator import FootstepTrajectoryGenerator, PreparedPlan
+from roughwalk.trajectories.step_sequence import plan_fields
 
 if TYPE_CHECKING:
     from roughwalk.robots.robot import Robot
@@ -69,13 +70,19 @@ _NEAR_PLAN_M = 0.025
 
 
 class _Plan:
-    """One plan being executed: its steps' legs and the trajectory iterator."""
+    """One plan being executed: its steps' legs and the trajectory iterator.
 
-    def __init__(self, attempt: PlanAttempt, prepared: PreparedPlan, steps: Iterator[Any]) -> None:
+    ``prepared`` is None for a plan with no step (its start was already at
+    the goal): nothing to walk.
+    """
+
+    def __init__(
+        self, attempt: PlanAttempt, prepared: PreparedPlan | None, steps: Iterator[Any]
+    ) -> None:
         self.attempt = attempt
         self.prepared = prepared
         self.steps = steps
-        self.legs = [s.leg for s in prepared.sequence.steps]
+        self.legs = [s.leg for s in prepared.sequence.steps] if prepared is not None else []
         self.exhausted = False
 
 
@@ -152,6 +159,12 @@ class Executor:
         if not attempt.ok:
             return None, attempt, time.perf_counter() - began
         try:
+            if len(plan_fields(attempt.plan)["footsteps"]) <= 4:
+                # The start was inside the planner's goal radius: the plan is
+                # the stance alone, and there is nothing left to walk.
+                self.plans.append(attempt.plan)
+                plan = _Plan(attempt, None, iter(()))
+                return plan, attempt, time.perf_counter() - began
             prepared = self.generator.prepare(attempt.plan)
         except PlanningError as e:
             failed = PlanAttempt(
@@ -203,7 +216,12 @@ class Executor:
         log.event(0.0, "plan", status=attempt.status, wall_s=wall, source=self.source.name)
         first = self._next_step(plan)[0] if plan is not None else None
         if plan is None or first is None:
-            reason = attempt.reason if plan is None else "the plan has no footsteps"
+            if plan is None:
+                reason = attempt.reason
+            elif plan.prepared is None:
+                reason = "the start is already at the goal"
+            else:
+                reason = "the plan has no footsteps"
             centroid = self._stance_centroid(start)
             monitor = OutcomeMonitor(goal_xy, centroid, cfg.outcome)
             return monitor.finish(0.0, failure=f"no plan: {reason}")

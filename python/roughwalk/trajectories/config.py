@@ -147,25 +147,31 @@ class SwingConfig:
         Where lift-off and drop-off sit along the stride (0: straight above
         start and target; 0.5: both at the middle). Small values lift
         vertically first; larger ones round the corners (with the ``"even"``
-        time law use 0.3: the foot sweeps its corners at speed, and rounder
-        ones keep that gentle, ~25 m/s² peak on a 10 cm stride in 0.33 s
-        against ~150 m/s² at 0.1, and need less joint speed).
+        time law, 0.3 (default): the foot sweeps its corners at speed, and
+        rounder ones keep that gentle, ~25 m/s² peak on a 10 cm stride in
+        0.33 s against ~150 m/s² at 0.1, and need less joint speed).
     time_law:
-        ``"even"``: the foot moves along its path at a steady speed (in the
-        metric below) with smooth ramps at both ends, so its joints' peak
-        speeds sit nearer their means and the velocity limits allow a
+        ``"even"`` (default): the foot moves along its path at a steady speed
+        (in the metric below) with smooth ramps at both ends, so its joints'
+        peak speeds sit nearer their means and the velocity limits allow a
         shorter swing (§5.2's timing rule is then less pessimistic).
-        ``"knots"`` (default): each spline segment takes time in proportion
-        to its length (the foot halts vertically at lift-off and drop-off
-        and dashes through the short lift and drop; peak joint speeds
-        2.3–3.8 times their means on LittleDog). Measured in MuJoCo with
-        ``lift_fraction`` 0.3: swings 0.42–0.64 → 0.30–0.36 s, flat 3.3 →
-        4.6 cm/s, barrier 3.1 → 4.2, steps 3.0 → 4.2 (one of two steps runs
-        fell), round rocks 2.6 → 3.2 (same 1 of 2 successes). Under a
-        1 N·s side push on flat ground both survive about half the push
-        times (9 times from 1.6 to 3.2 s: "even" 4, "knots" 5), but the
-        push test of ``test_sim_run`` (2.0 s) falls with "even", so it is
-        not the default until recovery copes with every phase.
+        ``"knots"``: each spline segment takes time in proportion to its
+        length (the foot halts vertically at lift-off and drop-off and
+        dashes through the short lift and drop; peak joint speeds 2.3–3.8
+        times their means on LittleDog; use it with ``lift_fraction`` 0.1).
+        Measured in MuJoCo (``roughwalk bench littledog --set
+        executor.compute_time_scale=0``, seeds 0–1), "knots" → "even":
+        swings 0.42–0.64 → 0.30–0.36 s; barrier 3.07 → 4.16 cm/s, steps
+        3.01 → 3.98, round rocks 2.60 → 3.21 (the same runs succeed: 2/2,
+        2/2, 1/2; sloped rocks 2/2 at 2.64 → 3.57; gap 0/2 → 1/2 at 3.71;
+        large rocks and logs 0/2 with both). Under a 1 N·s side push on
+        flat ground (``roughwalk bench push_recovery``, 17 push times from
+        1.6 to 4.8 s) "knots" survives 16 to the left and 12 to the right,
+        "even" 16 and 15; the falls
+        looked at are of one kind with both (pushed while a foot of the
+        other side swings, the trunk rolls over the feet it is pushed
+        towards), and the sweep's default 1.6–3.2 s window misses those of
+        "knots" (9/9 both ways; "even" 9/9 and 7/9).
     vertical_weight:
         With ``"even"``: one metre of vertical foot motion counts like this
         many metres of horizontal motion (LittleDog's hip and knee turn about
@@ -180,8 +186,8 @@ class SwingConfig:
     lift_height: float = 0.03
     clearance: float = 0.025
     scan_terrain: bool = True
-    lift_fraction: float = 0.1
-    time_law: str = "knots"
+    lift_fraction: float = 0.3
+    time_law: str = "even"
     vertical_weight: float = 1.5
     ramp_fraction: float = 0.2
 
