@@ -184,7 +184,6 @@ GUESS_START_OPTIONS: tuple[str, ...] = (
     "warm_start_mult_bound_push=1e-5",
     "mumps_scaling=0",
     "mumps_permuting_scaling=0",
-    "mumps_pivot_order=0",
 )
 """IPOPT's options for a start from predicted multipliers (see ``SolverOptions``)."""
 
@@ -268,11 +267,14 @@ class SolverOptions:
         take 1, and on TOWR's cost-free problem (L-BFGS) 12 where
         those take 1: a guess is not a solution. MUMPS's row/column scaling
         is off in them: on 30 held-out tasks the iterations were identical and
-        the CPU time per iteration 13 % lower (interleaved runs). Their MUMPS
-        ordering is AMD: with the exact Hessian, on 12 held-out single-pallet
-        tasks (fixed durations, same 177 iterations) AMD took 21.0–21.6 ms
-        of CPU an iteration against 22.2–23.9 for the automatic choice
-        (four interleaved pairs), QAMD 22.5, AMF 23.4, PORD 23.5, METIS 33.4.
+        the CPU time per iteration 13 % lower (interleaved runs). With the
+        exact Hessian and ``mumps_pivot_order`` None their MUMPS ordering is
+        AMD: on 12 held-out single-pallet tasks (fixed durations, same 177
+        iterations) AMD took 21.0–21.6 ms of CPU an iteration against
+        22.2–23.9 for the automatic choice (four interleaved pairs), QAMD
+        22.5, AMF 23.4, PORD 23.5, METIS 33.4. With L-BFGS the ordering
+        changes the iterations: TOWR's walk from its own solution took 18
+        with AMD and 3 with the automatic choice, which it keeps.
 
     Neither set applies to a solve from a guess without multipliers (the
     heuristic's cold solves).
