@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -14,11 +15,13 @@ from roughwalk.errors import ConfigError
 from roughwalk.learning import LearnedModel, ProblemSpec, build_problem, filter_good
 from roughwalk.learning.dataset import Dataset
 from roughwalk.learning.filtering import cost_threshold
+from roughwalk.learning.initializer import load_model
 from roughwalk.learning.mlp import MLP
 from roughwalk.learning.model_file import MODEL_FORMAT, problem_signature
 from roughwalk.trajopt import Task
 
 SPEC = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0)
+TASK = Task((0.1, -0.05, 0.2), (0.4, 0.0, 0.0))
 
 
 def _model(n_out: int, layout: list[list[object]], rng: np.random.Generator) -> LearnedModel:
@@ -50,6 +53,18 @@ def test_model_file_holds_arrays_only_and_predicts_the_same_after_reload(tmp_pat
     expected = model.mlp.out_mean + (np.tanh(x @ w0 + b0) @ w1 + b1)
     np.testing.assert_allclose(back.predict(task), expected, rtol=1e-5)
     back.check(nlp)  # the problem it was made for is accepted
+
+
+def test_model_file_is_read_once_per_version(tmp_path: Path) -> None:
+    nlp = build_problem(SPEC).formulation
+    layout = problem_signature(nlp)["layout"]
+    path = _model(nlp.n_variables, layout, np.random.default_rng(1)).save(tmp_path / "m.npz")
+    first = load_model(str(path))
+    assert load_model(str(path)) is first  # a solve per initialiser does not re-read it
+    os.utime(path, ns=(1, path.stat().st_mtime_ns + 1))  # the file rewritten
+    again = load_model(str(path))
+    assert again is not first
+    np.testing.assert_allclose(again.predict(TASK), first.predict(TASK))
 
 
 @pytest.mark.parametrize(

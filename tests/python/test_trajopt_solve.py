@@ -467,6 +467,39 @@ def test_mumps_scaling_follows_the_hessian_unless_set(tmp_path: Path) -> None:
     assert "mumps_scaling" not in kept
 
 
+def test_guess_solves_order_with_amd_only_with_the_exact_hessian(tmp_path: Path) -> None:
+    # A solve from predicted multipliers (the learned guess) builds its own IPOPT.
+    from dataclasses import replace
+
+    from roughwalk.trajopt.optimize import clear_cache
+
+    orders = {}
+    for hessian in ("exact", "limited-memory"):
+        clear_cache()
+        log = tmp_path / f"{hessian}.txt"
+        base = towr_config()
+        config = replace(
+            base,
+            solver=replace(
+                base.solver,
+                hessian=hessian,
+                ipopt_options=(f"output_file={log}", "file_print_level=5"),
+                guess_ipopt_options=(*base.solver.guess_ipopt_options, "print_user_options=yes"),
+            ),
+        )
+        task = ((0.0, 0.0, 0.0), (0.8, 0.0, 0.0))
+        kwargs = {"gait": "walk", "steps": 8, "duration": 3.0, "max_iter": 1}
+        first = optimize_motion(None, "flat", task, config=config, **kwargs)
+        _problem(config).solve(Task.from_any(task), _GuessWithMultipliers(first), max_iter=1)
+        for line in log.read_text().splitlines():
+            parts = line.split()
+            if len(parts) == 4 and parts[0] == "mumps_pivot_order" and parts[1] == "=":
+                orders[hessian] = parts[2]
+    clear_cache()
+    # AMD: the same iterations for less CPU; with L-BFGS it changed the iterations.
+    assert orders == {"exact": "0", "limited-memory": "7"}
+
+
 def test_mumps_ordering_follows_durations_and_hessian(tmp_path: Path) -> None:
     fixed = _ipopt_user_options(tmp_path, "fixed", solver__hessian="exact")
     assert fixed["mumps_pivot_order"] == "7"

@@ -181,8 +181,8 @@ GUESS_START_OPTIONS: tuple[str, ...] = (
     "mu_oracle=quality-function",
     "warm_start_bound_push=1e-5",
     "warm_start_bound_frac=1e-5",
-    "warm_start_slack_bound_push=1e-5",
-    "warm_start_slack_bound_frac=1e-5",
+    "warm_start_slack_bound_push=1e-2",
+    "warm_start_slack_bound_frac=1e-2",
     "warm_start_mult_bound_push=1e-5",
     "mumps_scaling=0",
     "mumps_permuting_scaling=0",
@@ -258,11 +258,25 @@ class SolverOptions:
         held-out single-pallet tasks from the learned guess: with the warm
         options above the median was 19.5 iterations, with these (pushes
         1e-5, quality-function barrier oracle) 14–16; larger pushes (1e-2)
-        double it. From an exact solution they take 2 iterations where the
-        warm options take 1, and on TOWR's cost-free problem (L-BFGS) 12 where
+        on everything double it. The slacks of the inequality rows alone
+        start 1e-2 inside their bounds: on 50 held-out single-pallet tasks
+        (exact Hessian) the iterations went from 876 (median 16) with 1e-5 to
+        789 (14) with 1e-3, 762 (13) with 1e-2, 785 with 3e-2 and 823 with
+        1e-1, every task to the same cost; the variables' push made no
+        difference at 1e-3 and the multipliers' (1e-3) cost 15 % more.
+        From an exact solution they take 2–5 iterations (2 with the slacks'
+        push at 1e-5, on 5 single-pallet tasks) where the warm options
+        take 1, and on TOWR's cost-free problem (L-BFGS) 12 where
         those take 1: a guess is not a solution. MUMPS's row/column scaling
         is off in them: on 30 held-out tasks the iterations were identical and
-        the CPU time per iteration 13 % lower (interleaved runs).
+        the CPU time per iteration 13 % lower (interleaved runs). With the
+        exact Hessian and ``mumps_pivot_order`` None their MUMPS ordering is
+        AMD: on 12 held-out single-pallet tasks (fixed durations, same 177
+        iterations) AMD took 21.0–21.6 ms of CPU an iteration against
+        22.2–23.9 for the automatic choice (four interleaved pairs), QAMD
+        22.5, AMF 23.4, PORD 23.5, METIS 33.4. With L-BFGS the ordering
+        changes the iterations: TOWR's walk from its own solution took 18
+        with AMD and 3 with the automatic choice, which it keeps.
 
     Neither set applies to a solve from a guess without multipliers (the
     heuristic's cold solves).

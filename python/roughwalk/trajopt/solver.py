@@ -306,6 +306,14 @@ class TrajoptSolver:
         kind = "guess" if predicted else "warm"
         if kind not in self._warm_solvers:
             ipopt = dict(self._options["ipopt"])
+            if (
+                predicted
+                and self.hessian == "exact"
+                and self.options.linear_solver == "mumps"
+                and self.options.mumps_pivot_order is None
+            ):
+                # AMD: the same iterations, 5–9 % less CPU each (SolverOptions).
+                ipopt["mumps_pivot_order"] = 0
             extra = (
                 self.options.guess_ipopt_options if predicted else self.options.warm_ipopt_options
             )
