@@ -12,7 +12,7 @@ motion, and reports per push time whether the robot reached the goal, and
 its reflexes and re-plans.
 
 Run: ``roughwalk bench push_recovery [--impulse 1.0] [--direction 90]
-[--from 1.6] [--to 3.2] [--step 0.2] [--terrain flat] [--set KEY=VALUE ...]``;
+[--from 1.6] [--to 4.8] [--step 0.2] [--terrain flat] [--set KEY=VALUE ...]``;
 ``--set`` overrides a simulation setting or, prefixed ``trajectory.``, a
 setting of trajectory generation (``trajectory.swing.time_law=even``), as
 in ``roughwalk bench littledog``. Writes ``benchmarks/results/push_recovery.json``.
@@ -81,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
         "--direction", type=float, default=90.0, help="push direction from +x [deg] (90: left)"
     )
     ap.add_argument("--from", dest="first", type=float, default=1.6, help="first push time [s]")
-    ap.add_argument("--to", dest="last", type=float, default=3.2, help="last push time [s]")
+    ap.add_argument("--to", dest="last", type=float, default=4.8, help="last push time [s]")
     ap.add_argument("--step", type=float, default=0.2, help="push time step [s]")
     ap.add_argument("--terrain", default="flat", help="terrain spec")
     ap.add_argument("--expansions", type=int, default=2000, help="planner expansion budget")
