@@ -60,3 +60,13 @@ def test_a_named_body_model_still_names_the_robot_that_executes_it(tmp_path: Pat
     assert main([*FLAGS, "--set", "body_model=towr_anymal", "--json", str(out)]) == 0
     data = json.loads(out.read_text())
     assert data["robot"] == "anymal_c" and data["body_model"] == "towr_anymal"
+
+
+def test_leg_reach_flag_adds_the_reach_rows(tmp_path: Path) -> None:
+    """``--leg-reach`` puts the ball-per-leg constraint into the problem; without it, none."""
+    counts = []
+    for extra in ([], ["--leg-reach"]):
+        out = tmp_path / f"reach{len(extra)}.json"
+        main([*FLAGS, "--max-iter", "0", *extra, "--json", str(out)])
+        counts.append(json.loads(out.read_text())["n_constraints"])
+    assert counts[1] > counts[0]

@@ -19,7 +19,7 @@ from roughwalk.trajopt import (
     optimize_motion,
     rigid_body_from_robot,
 )
-from roughwalk.trajopt.parameters import MELON_CONSTRAINTS
+from roughwalk.trajopt.parameters import MELON_CONSTRAINTS, MELON_REACH_CONSTRAINTS
 from roughwalk.trajopt.robot_model import leg_reach_sphere
 
 MIN_KNEE_BEND = 0.35
@@ -152,10 +152,12 @@ def test_single_pallet_plans_keep_stance_feet_within_reach(anymal: Robot) -> Non
     """With the ball, the planned base reaches its stance feet; with the box alone it does not."""
     terrain = load_terrain("single_pallet")
     task = Task((0.0, 0.2, 0.2), (1.6, 0.0, 0.0))
-    with_ball = optimize_motion(anymal, terrain, task, config=melon_config())
+    with_ball = optimize_motion(
+        anymal, terrain, task, config=melon_config(constraints=MELON_REACH_CONSTRAINTS)
+    )
     assert with_ball.solved
     assert _unreachable_fraction(with_ball, anymal) < 0.01
-    box_only = melon_config(constraints=tuple(c for c in MELON_CONSTRAINTS if c != "leg_reach"))
+    box_only = melon_config(constraints=MELON_CONSTRAINTS)
     without = optimize_motion(anymal, terrain, task, config=box_only)
     assert without.solved
     assert _unreachable_fraction(without, anymal) > 0.1

@@ -41,6 +41,12 @@ def register(sub: Any) -> None:
         help="keep the gait's phase durations (the default; optimise them with "
         "--set optimize_durations=true)",
     )
+    p.add_argument(
+        "--leg-reach",
+        action="store_true",
+        help="also keep every foot within its leg's real reach (a ball per leg; "
+        "off by default until the shipped learned initialisers are retrained with it)",
+    )
     add_output_args(p, picture=True, npz=True)
     p.set_defaults(func=cmd_optimize)
 
@@ -67,6 +73,8 @@ def cmd_optimize(args: argparse.Namespace) -> int:
         overrides["optimize_durations"] = False
     if args.max_iter is not None:
         overrides["solver__max_iter"] = args.max_iter
+    if args.leg_reach and "leg_reach" not in config.constraints:
+        overrides["constraints"] = (*config.constraints, "leg_reach")
     robot = load_robot(args.robot) if config.body_model == "robot" else None
     terrain = load_terrain(args.terrain)
     task = Task(parse_pose(args.start, "--start"), parse_pose(args.goal, "--goal"))
