@@ -101,3 +101,19 @@ def test_killed_run_resumes_to_the_same_dataset(tmp_path: Path) -> None:
     assert Dataset.load(tmp_path / "resumed" / "dataset.npz").same_rows(whole)
     with pytest.raises(ConfigError, match="another 'seed'"):
         generate(SPEC, SPACE, 4, tmp_path / "resumed", seed=1, progress=None)
+
+
+def test_a_run_is_not_resumed_under_another_constraint_set(tmp_path: Path, monkeypatch) -> None:
+    """Solves of a problem with other constraints must not be mixed into the run."""
+    from dataclasses import replace
+
+    generate(SPEC, SPACE, 0, tmp_path / "run", progress=None)
+    original = ProblemSpec.config
+
+    def with_reach(self: ProblemSpec):  # type: ignore[no-untyped-def]
+        cfg = original(self)
+        return replace(cfg, constraints=(*cfg.constraints, "leg_reach"))
+
+    monkeypatch.setattr(ProblemSpec, "config", with_reach)
+    with pytest.raises(ConfigError, match="another 'constraints'"):
+        generate(SPEC, SPACE, 0, tmp_path / "run", progress=None)

@@ -288,6 +288,9 @@ def generate(
         folder,
         {
             "problem": spec.to_dict(),
+            # The constraint set is not part of the spec (models predate it), but a
+            # run resumed under another set would mix two problems' solves.
+            "constraints": list(spec.config().constraints),
             "task_space": space.to_dict(),
             "split": split,
             "seed": seed,
