@@ -42,7 +42,12 @@ from typing import Any
 import numpy as np
 
 import roughwalk as rw
-from roughwalk.cli.common import machine_description, result_envelope, write_json
+from roughwalk.cli.common import (
+    machine_description,
+    result_envelope,
+    simulation_settings,
+    write_json,
+)
 from roughwalk.sim import FrictionDrop, MapError, Push, run
 
 RESULTS = Path(__file__).resolve().parent / "results" / "littledog.json"
@@ -198,19 +203,11 @@ def main(argv: list[str] | None = None) -> int:
         "setting (repeatable, dotted keys)",
     )
     args = ap.parse_args(argv)
-    sets: list[tuple[str, str]] = []
-    for item in args.set:
-        key, eq, value = item.partition("=")
-        if not eq or not key.strip():
-            ap.error(f"--set takes KEY=VALUE, got {item!r}")
-        sets.append((key.strip(), value.strip()))
     try:
-        rw.sim.sim_config(**{k: v for k, v in sets if not k.startswith("trajectory.")})
-        rw.trajectories.trajectory_config(
-            **{k.removeprefix("trajectory."): v for k, v in sets if k.startswith("trajectory.")}
-        )
+        sim_sets, traj_sets = simulation_settings(args.set)
     except rw.ConfigError as e:
         ap.error(str(e))
+    sets = [*sim_sets.items(), *((f"trajectory.{k}", v) for k, v in traj_sets.items())]
     seeds = args.seeds if args.seeds is not None else (10 if args.full else 2)
     classes = [c.strip() for c in args.classes.split(",") if c.strip()]
     unknown = set(classes) - set(CLASSES)

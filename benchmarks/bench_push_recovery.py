@@ -28,7 +28,12 @@ from typing import Any
 import numpy as np
 
 import roughwalk as rw
-from roughwalk.cli.common import machine_description, result_envelope, write_json
+from roughwalk.cli.common import (
+    machine_description,
+    result_envelope,
+    simulation_settings,
+    write_json,
+)
 from roughwalk.sim import Push, run
 from roughwalk.sim.footstep_source import PlannerSource
 
@@ -95,22 +100,11 @@ def main(argv: list[str] | None = None) -> int:
         "setting (repeatable, dotted keys)",
     )
     args = ap.parse_args(argv)
-    sets: dict[str, Any] = {}
-    traj: dict[str, Any] = {}
-    for item in args.set:
-        key, eq, value = item.partition("=")
-        key = key.strip()
-        if not eq or not key:
-            ap.error(f"--set takes KEY=VALUE, got {item!r}")
-        if key.startswith("trajectory."):
-            traj[key.removeprefix("trajectory.")] = value.strip()
-        else:
-            sets[key] = value.strip()
     try:
-        rw.sim.sim_config(**sets)
-        trajectory_config = rw.trajectories.trajectory_config(**traj) if traj else None
+        sets, traj = simulation_settings(args.set)
     except rw.ConfigError as e:
         ap.error(str(e))
+    trajectory_config = rw.trajectories.trajectory_config(**traj) if traj else None
     robot = rw.load_robot("littledog")
     terrain = rw.load_terrain(args.terrain)
     source = PlannerSource(robot, terrain, expansions=args.expansions)

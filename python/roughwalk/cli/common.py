@@ -12,7 +12,14 @@ import numpy as np
 
 from roughwalk import __version__
 
-__all__ = ["write_json", "result_envelope", "machine_description", "add_output_args", "info"]
+__all__ = [
+    "write_json",
+    "result_envelope",
+    "machine_description",
+    "add_output_args",
+    "info",
+    "simulation_settings",
+]
 
 SCHEMA_VERSION = 1
 
@@ -84,3 +91,31 @@ def add_output_args(parser: Any, *, picture: bool = False, npz: bool = False) ->
 def info(message: str) -> None:
     """Print a progress or status line to stderr (stdout stays for results)."""
     print(message, file=sys.stderr, flush=True)
+
+
+def simulation_settings(items: list[str]) -> tuple[dict[str, str], dict[str, str]]:
+    """``--set KEY=VALUE`` items as (simulation, trajectory) settings, both checked.
+
+    Keys prefixed ``trajectory.`` go, without the prefix, to
+    :func:`roughwalk.trajectories.trajectory_config`; the others to
+    :func:`roughwalk.sim.sim_config`. A malformed item or an unknown key or
+    value raises :class:`~roughwalk.errors.ConfigError` before any run.
+    """
+    from roughwalk.errors import ConfigError
+    from roughwalk.sim import sim_config
+    from roughwalk.trajectories import trajectory_config
+
+    sim: dict[str, str] = {}
+    trajectory: dict[str, str] = {}
+    for item in items:
+        key, eq, value = item.partition("=")
+        key = key.strip()
+        if not eq or not key:
+            raise ConfigError(f"--set takes KEY=VALUE, got {item!r}")
+        if key.startswith("trajectory."):
+            trajectory[key.removeprefix("trajectory.")] = value.strip()
+        else:
+            sim[key] = value.strip()
+    sim_config(None, **sim)
+    trajectory_config(None, **trajectory)
+    return sim, trajectory
