@@ -418,7 +418,7 @@ class Executor:
         self._reflex_next_leg = self._next_leg(desired)
         self._settle_deadline = None
         self._reflex_planned_feet = np.array(planned, dtype=float)
-        in_contact = measured.foot_forces[:, 2] > 1.0
+        in_contact = measured.foot_forces[:, 2] > _LOADED_N
         self._plan = None
         self.buffer.clear()
         self.integrator.reset()
