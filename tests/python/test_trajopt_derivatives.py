@@ -283,3 +283,37 @@ def test_hessian_equals_casadis_of_the_whole_lagrangian(
     hess = np.asarray(ca.densify(nlp.hess_lag(x, p, 0.7, lam_g)))
     assert np.max(np.abs(expected)) > 100.0
     np.testing.assert_allclose(hess, expected, rtol=0, atol=1e-9 * np.max(np.abs(expected)))
+
+
+@pytest.mark.parametrize(
+    ("optimize_durations", "reach"), [(False, False), (True, False), (False, True)]
+)
+def test_jacobian_equals_casadis_of_the_whole_constraints(
+    optimize_durations: bool, reach: bool
+) -> None:
+    # With fixed durations the rows made of calls are differentiated as
+    # blockdiag(∂F/∂u)·A and projected onto the rows' sparsity; IPOPT must see
+    # the structure and values of CasADi's Jacobian of g as one MX expression.
+    constraints = MELON_REACH_CONSTRAINTS if reach else MELON_CONSTRAINTS
+    config = melon_config(
+        duration=2.0, steps=4, optimize_durations=optimize_durations, constraints=constraints
+    )
+    body = rigid_body_from_robot(load_robot("anymal_c")) if reach else TOWR_ANYMAL
+    terrain = TerrainModel(
+        load_terrain("single_pallet"), config.terrain, config.costs.step_edge_sigma
+    )
+    nlp = Formulation(config, body, make_gait("walk", 4, 2.0), terrain)
+    task = resolve(Task((0.55, 0.0, 0.0), (0.95, 0.05, 0.1)), body, terrain)
+    rng = np.random.default_rng(5)
+    x = HeuristicInitializer().guess(nlp, task) + 0.01 * rng.normal(size=nlp.n_variables)
+    p = task.vector()
+    x_mx, p_mx = nlp.nlp["x"], nlp.nlp["p"]
+    reference = ca.Function("reference", [x_mx, p_mx], [ca.jacobian(nlp.nlp["g"], x_mx)])
+    expected = reference(x, p)
+    _, jac = nlp.jac_g(x, p)
+    assert jac.sparsity() == expected.sparsity()
+    dense, dense_expected = np.asarray(ca.densify(jac)), np.asarray(ca.densify(expected))
+    assert np.max(np.abs(dense_expected)) > 100.0
+    np.testing.assert_allclose(
+        dense, dense_expected, rtol=0, atol=1e-12 * np.max(np.abs(dense_expected))
+    )

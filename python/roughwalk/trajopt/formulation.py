@@ -93,6 +93,30 @@ def _chunk_hessians(expr: ca.SX, weights: ca.SX, z: ca.SX, rows_per_block: int) 
     return blocks
 
 
+def _call_jacobian(rows: Rows, z: ca.SX) -> ca.SX | None:
+    """∂g/∂z of rows made of calls g = F(u) of one function F, when u = A z + b.
+
+    blockdiag(∂F/∂u mapped over the calls) · A, projected onto the rows'
+    own sparsity so that IPOPT sees the same structure as from
+    differentiating the rows: about a third of the CPU of the row blocks'
+    Jacobians. None when the calls mix functions or u is not affine in z
+    (optimised durations), where the row blocks are cheaper.
+    """
+    calls = rows.calls or []
+    if not calls or any(call.function is not calls[0].function for call in calls):
+        return None
+    fn = calls[0].function
+    points = ca.horzcat(*[ca.vertcat(*[ca.vec(v) for v in call.inputs]) for call in calls])
+    a = ca.jacobian(ca.vec(points), z)
+    if not a.is_constant():
+        return None
+    symbols = [ca.SX.sym(f"u{i}", fn.sparsity_in(i)) for i in range(fn.n_in())]
+    flat = ca.vertcat(*[ca.vec(v) for v in symbols])
+    local = ca.Function(f"{fn.name()}_jacobian", [flat], [ca.jacobian(ca.vec(fn(*symbols)), flat)])
+    diagonal = ca.diagcat(*ca.horzsplit(local.map(len(calls))(points), int(flat.numel())))
+    return ca.project(diagonal @ ca.DM(a), ca.jacobian_sparsity(rows.expr, z))
+
+
 def _call_hessians(
     rows: Rows, weights: ca.SX, z: ca.SX
 ) -> tuple[list[ca.SX], list[tuple[ca.SX, ca.SX]]]:
@@ -302,6 +326,13 @@ class Formulation:
         nx = self.n_variables
         jac_blocks = []
         for rows in self.rows:
+            # With optimised durations the points are not affine (the check alone
+            # would cost more than the row blocks).
+            affine = rows.calls is not None and not self.config.optimize_durations
+            call_jacobian = _call_jacobian(rows, z) if affine else None
+            if call_jacobian is not None:
+                jac_blocks.append(call_jacobian)
+                continue
             for start in range(0, rows.size, _ROWS_PER_BLOCK):
                 chunk = rows.expr[start : min(start + _ROWS_PER_BLOCK, rows.size)]
                 jac_blocks.append(ca.jacobian(chunk, z))
