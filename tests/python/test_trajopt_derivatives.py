@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
+from roughwalk.robots import load_robot
 from roughwalk.terrain import load_terrain
 from roughwalk.trajopt import (
     TOWR_ANYMAL,
@@ -15,10 +16,12 @@ from roughwalk.trajopt import (
     TerrainModel,
     make_gait,
     melon_config,
+    rigid_body_from_robot,
 )
 from roughwalk.trajopt.costs.integral import melon_integral
 from roughwalk.trajopt.costs.normal_force import stance_share
 from roughwalk.trajopt.optimize import _splines
+from roughwalk.trajopt.parameters import MELON_CONSTRAINTS, MELON_REACH_CONSTRAINTS
 from roughwalk.trajopt.task import Task, resolve
 from roughwalk.trajopt.variables import (
     NumericSpline,
@@ -242,19 +245,30 @@ def test_terrain_gradient_and_edges() -> None:
     assert cost[0] > 0.9 and cost[1] < cost[0] and cost[2] < 1e-3 and cost[3] < 1e-3
 
 
-@pytest.mark.parametrize("optimize_durations", [False, True])
-def test_hessian_equals_casadis_of_the_whole_lagrangian(optimize_durations: bool) -> None:
-    # The dynamics and range-of-motion rows are mapped from their functions' own
-    # small Hessians (Aᵀ ∇²ᵤ A); with optimised durations their inputs are not
-    # affine and they fall back to the rows' Hessian. Both must equal CasADi's
-    # Hessian of the Lagrangian as one MX expression, terrain splines included.
-    config = melon_config(duration=2.0, steps=4, optimize_durations=optimize_durations)
+@pytest.mark.parametrize(
+    ("optimize_durations", "reach"), [(False, False), (True, False), (False, True), (True, True)]
+)
+def test_hessian_equals_casadis_of_the_whole_lagrangian(
+    optimize_durations: bool, reach: bool
+) -> None:
+    # The dynamics, range-of-motion and leg-reach rows are mapped from their
+    # functions' own small Hessians (Aᵀ ∇²ᵤ A), all calls of a function at once;
+    # with optimised durations their inputs are not affine and the points'
+    # curvature is added. Both must equal CasADi's Hessian of the Lagrangian
+    # as one MX expression, terrain splines included.
+    constraints = MELON_REACH_CONSTRAINTS if reach else MELON_CONSTRAINTS
+    config = melon_config(
+        duration=2.0, steps=4, optimize_durations=optimize_durations, constraints=constraints
+    )
+    body = rigid_body_from_robot(load_robot("anymal_c")) if reach else TOWR_ANYMAL
     terrain = TerrainModel(
         load_terrain("single_pallet"), config.terrain, config.costs.step_edge_sigma
     )
-    nlp = Formulation(config, TOWR_ANYMAL, make_gait("walk", 4, 2.0), terrain)
-    assert any(rows.calls for rows in nlp.rows)
-    task = resolve(Task((0.55, 0.0, 0.0), (0.95, 0.05, 0.1)), TOWR_ANYMAL, terrain)
+    nlp = Formulation(config, body, make_gait("walk", 4, 2.0), terrain)
+    called = {rows.name for rows in nlp.rows if rows.calls}
+    assert {"dynamics", "range_of_motion"} <= called
+    assert ("leg_reach" in called) == reach
+    task = resolve(Task((0.55, 0.0, 0.0), (0.95, 0.05, 0.1)), body, terrain)
     rng = np.random.default_rng(7)
     x = HeuristicInitializer().guess(nlp, task) + 0.01 * rng.normal(size=nlp.n_variables)
     p = task.vector()
@@ -269,3 +283,37 @@ def test_hessian_equals_casadis_of_the_whole_lagrangian(optimize_durations: bool
     hess = np.asarray(ca.densify(nlp.hess_lag(x, p, 0.7, lam_g)))
     assert np.max(np.abs(expected)) > 100.0
     np.testing.assert_allclose(hess, expected, rtol=0, atol=1e-9 * np.max(np.abs(expected)))
+
+
+@pytest.mark.parametrize(
+    ("optimize_durations", "reach"), [(False, False), (True, False), (False, True)]
+)
+def test_jacobian_equals_casadis_of_the_whole_constraints(
+    optimize_durations: bool, reach: bool
+) -> None:
+    # With fixed durations the rows made of calls are differentiated as
+    # blockdiag(∂F/∂u)·A and projected onto the rows' sparsity; IPOPT must see
+    # the structure and values of CasADi's Jacobian of g as one MX expression.
+    constraints = MELON_REACH_CONSTRAINTS if reach else MELON_CONSTRAINTS
+    config = melon_config(
+        duration=2.0, steps=4, optimize_durations=optimize_durations, constraints=constraints
+    )
+    body = rigid_body_from_robot(load_robot("anymal_c")) if reach else TOWR_ANYMAL
+    terrain = TerrainModel(
+        load_terrain("single_pallet"), config.terrain, config.costs.step_edge_sigma
+    )
+    nlp = Formulation(config, body, make_gait("walk", 4, 2.0), terrain)
+    task = resolve(Task((0.55, 0.0, 0.0), (0.95, 0.05, 0.1)), body, terrain)
+    rng = np.random.default_rng(5)
+    x = HeuristicInitializer().guess(nlp, task) + 0.01 * rng.normal(size=nlp.n_variables)
+    p = task.vector()
+    x_mx, p_mx = nlp.nlp["x"], nlp.nlp["p"]
+    reference = ca.Function("reference", [x_mx, p_mx], [ca.jacobian(nlp.nlp["g"], x_mx)])
+    expected = reference(x, p)
+    _, jac = nlp.jac_g(x, p)
+    assert jac.sparsity() == expected.sparsity()
+    dense, dense_expected = np.asarray(ca.densify(jac)), np.asarray(ca.densify(expected))
+    assert np.max(np.abs(dense_expected)) > 100.0
+    np.testing.assert_allclose(
+        dense, dense_expected, rtol=0, atol=1e-12 * np.max(np.abs(dense_expected))
+    )

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import casadi as ca
 import numpy as np
 
-from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_rows
+from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_calls
 from roughwalk.trajopt.variables import euler_to_rotation
 
 if TYPE_CHECKING:
@@ -50,7 +50,8 @@ class LegReach(Constraint):
             base = nlp.base_lin.spline.point(t)[0]
             angles = nlp.base_ang.spline.point(t)[0]
             for i, motion in enumerate(nlp.feet):
-                parts.append(
-                    (squared(base, angles, motion.spline.point(t)[0], centre[i]), 0.0, radius**2)
-                )
-        return stack_rows(self.name, parts)
+                point = motion.spline.point(t)[0]
+                parts.append(((base, angles, point, ca.SX(ca.DM(centre[i]))), 0.0, radius**2))
+        # Kept as calls: the formulation builds their Hessian from the
+        # function's own small one (see Call), not from the inlined rows.
+        return stack_calls(self.name, squared, parts)
