@@ -74,9 +74,15 @@ class CertificateConfig:
     stall_rounds:
         The search also gives up after this many rounds without cutting its
         total violation (foot errors, CoM and clearance deficits) by a tenth:
-        stuck, typically a shin against a rock no trunk motion frees. Larger
-        keeps a few more stances (2-3 % on the LittleDog boards from 3 to 4)
-        at a large cost in time (most rejected actions end this way).
+        stuck, typically a shin against a rock no trunk motion frees, or the
+        obstacle step lifting the trunk and the reachability step pulling it
+        back down in turn (most rejections on the logs). Larger keeps a few
+        more stances (2-3 % on the LittleDog boards from 3 to 4) at a large
+        cost in time. Measured from 3 to 2 on the five bench courses (20,000
+        expansions): first plan on the logs 0.18 -> 0.10 s CPU, actions per
+        CPU second +3-17 %, final costs equal or lower on every course, first
+        costs equal except large rocks (+6 %, found in half the time) and
+        logs (+0.7 %).
     alpha_reach, beta_reach:
         Translation [1] and rotation [rad/m²] step sizes of the reachability
         correction (§3.2). Larger converges in fewer rounds but may overshoot.
@@ -122,7 +128,7 @@ class CertificateConfig:
     """
 
     max_iterations: int = 25
-    stall_rounds: int = 3
+    stall_rounds: int = 2
     alpha_reach: float = 0.7
     beta_reach: float = 50.0
     reach_overshoot: float = 0.002

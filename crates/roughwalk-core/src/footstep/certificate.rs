@@ -434,13 +434,25 @@ impl CertificateSearch<'_> {
                 );
                 dx = add(dx, [target[0] - com[0], target[1] - com[1], 0.0]);
             }
+            // A round that fails on reach or CoM and cannot lower the
+            // violation enough (the clearance deficit only adds to it) ends
+            // the search whatever the clearance: skip its collision check.
+            let last = iteration == cfg.max_iterations
+                || (violation >= 0.9 * best && stalled + 1 >= cfg.stall_rounds);
+            if last && !(reachable && com_ok) {
+                failure = if reachable {
+                    CertificateFailure::CenterOfMass
+                } else {
+                    CertificateFailure::Unreachable
+                };
+                break;
+            }
             let closest = self
                 .collision
                 .closest_below(self.sdf, &pose, &frames, cutoff, spacing);
             let collision = closest.filter(|c| c.distance < required);
             if let Some(c) = collision {
                 violation += required - c.distance;
-                self.obstacle_step(feet, &pose, &frames, &c, required, &mut dx, &mut omega);
             }
             if reachable && com_ok && collision.is_none() {
                 return Ok(self.certificate(&pose, q, &frames, com, com_margin, closest, iteration));
@@ -459,6 +471,13 @@ impl CertificateSearch<'_> {
                 if stalled >= cfg.stall_rounds {
                     break;
                 }
+            }
+            if iteration == cfg.max_iterations {
+                break;
+            }
+            // The obstacle step only once the search goes on.
+            if let Some(c) = collision {
+                self.obstacle_step(feet, &pose, &frames, &c, required, &mut dx, &mut omega);
             }
             let (step, turn) = (norm(dx), norm(omega));
             if step > cfg.max_step {

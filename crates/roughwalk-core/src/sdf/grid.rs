@@ -213,18 +213,16 @@ impl DistanceGrid {
     #[inline(always)]
     pub fn corners(&self, base: usize) -> [f32; 8] {
         let [sx, nz] = self.stride;
-        // One bounds check for the whole cell instead of eight.
-        let v = &self.values[base..=base + sx + nz + 1];
-        [
-            v[0],
-            v[1],
-            v[nz],
-            v[nz + 1],
-            v[sx],
-            v[sx + 1],
-            v[sx + nz],
-            v[sx + nz + 1],
-        ]
+        // Two x-planes of the cell as fixed-size pairs: the slicing checks
+        // the bounds once per pair, the pairs' own indexing not at all
+        // (indexing the cell's slice checked each of the eight corners).
+        let pair = |i: usize| -> [f32; 2] {
+            let p: &[f32; 2] = self.values[i..i + 2].try_into().expect("two nodes");
+            *p
+        };
+        let ([c0, c1], [c2, c3]) = (pair(base), pair(base + nz));
+        let ([c4, c5], [c6, c7]) = (pair(base + sx), pair(base + sx + nz));
+        [c0, c1, c2, c3, c4, c5, c6, c7]
     }
 
     /// Trilinear value [m] and gradient from a cell's corners and fractions.
