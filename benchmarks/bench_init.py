@@ -26,7 +26,11 @@ initial guess included, the NLP's build not).
 Beyond g_max counts tasks whose cost is above one threshold for all tasks;
 where the task space's costs differ by task (far starts cost more on the
 single pallet), "worse than the best" counts, per task, the initialisers
-whose cost is more than 2 % above the best any of them reached on it.
+whose cost is more than 2 % above the best any of them reached on it, and
+"beyond task g_max" counts costs above the threshold the model's training
+predicts for the task itself (:class:`~roughwalk.learning.TaskCostModel`,
+in the model header): the poor minima, not the costly tasks. Both the
+global and the per-task figures are reported.
 
 Run: ``roughwalk bench init [--env single_pallet] [--models DIR] [--tasks N]``.
 Writes ``benchmarks/results/init_ENV.json`` and ``init_ENV.png``.
@@ -49,6 +53,7 @@ from roughwalk.learning import (
     Dataset,
     LearnedModel,
     ProblemSpec,
+    TaskCostModel,
     build_problem,
     generate,
     shipped_models,
@@ -78,10 +83,20 @@ def _models(folder: Path | None, env: str) -> list[tuple[str, LearnedModel]]:
 WORSE_THAN_BEST = 1.02  # a cost more than 2 % above the task's best counts as a worse minimum
 
 
-def _summary(data: Dataset, g_max: float, limit: int, best: np.ndarray) -> dict[str, Any]:
+def _summary(
+    data: Dataset,
+    g_max: float,
+    limit: int,
+    best: np.ndarray,
+    cost_model: TaskCostModel | None,
+) -> dict[str, Any]:
     solved = np.isin(data["status"], ("exact", "approximate"))
     feasible = feasible_mask(data)
     beyond = ~feasible | (data["cost"] > g_max)
+    beyond_task = None
+    if cost_model is not None:
+        per_task = cost_model.threshold(np.column_stack([data["start"], data["goal"]]))
+        beyond_task = float(np.mean(~feasible | (data["cost"] > per_task)))
     worse = ~feasible | (data["cost"] > WORSE_THAN_BEST * best)
     its = data["iterations"]
     curve = [float(np.mean(solved & (its <= k))) for k in range(limit + 1)]
@@ -92,6 +107,7 @@ def _summary(data: Dataset, g_max: float, limit: int, best: np.ndarray) -> dict[
         "median_iterations": float(np.median(its[solved])) if solved.any() else float("nan"),
         "median_solve_s": float(np.median(times)) if times.size else float("nan"),
         "beyond_g_max": float(beyond.mean()),
+        "beyond_task_g_max": beyond_task,
         "worse_than_best": float(worse.mean()),
         "median_cost": float(np.median(data["cost"][feasible])) if feasible.any() else None,
         "converged_by_iteration": curve,
@@ -111,9 +127,12 @@ def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:
     )
     models = _models(args.models, args.env)
     g_max = None
+    cost_model = None
     for name, model in models:
         model.check_signature(spec.to_dict())
         g_max = float(model.header["training"]["g_max"])
+        fitted = model.header["training"].get("task_cost_model")
+        cost_model = TaskCostModel.from_dict(fitted) if fitted else cost_model
         runs[name] = generate(
             spec,
             space,
@@ -133,7 +152,10 @@ def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:
     best = costs.min(axis=0)
     return {
         "g_max": g_max,
-        "initializers": {k: _summary(v, g_max, args.max_iter, best) for k, v in runs.items()},
+        "task_cost_model": None if cost_model is None else cost_model.to_dict(),
+        "initializers": {
+            k: _summary(v, g_max, args.max_iter, best, cost_model) for k, v in runs.items()
+        },
     }
 
 
@@ -296,12 +318,14 @@ def main() -> None:
     print(f"Figure 6, {args.env}: {args.tasks} held-out tasks, g_max {fig6['g_max']:.4g}")
     print(
         f"{'initialiser':28s} {'conv.':>6s} {'med. it':>8s} {'med. s':>8s} {'>g_max':>7s} "
-        f"{'>best':>7s}"
+        f"{'>best':>7s} {'>task g_max':>11s}"
     )
     for name, s in inits.items():
+        per_task = s["beyond_task_g_max"]
         print(
             f"{name:28s} {s['converged']:6.0%} {s['median_iterations']:8.1f} "
-            f"{s['median_solve_s']:8.3f} {s['beyond_g_max']:7.1%} {s['worse_than_best']:7.1%}"
+            f"{s['median_solve_s']:8.3f} {s['beyond_g_max']:7.1%} {s['worse_than_best']:7.1%} "
+            f"{'—' if per_task is None else f'{per_task:.1%}':>11s}"
         )
     if times:
         print(f"timed back to back ({args.timing_tasks} tasks, medians):")
@@ -325,6 +349,10 @@ def main() -> None:
             },
             "iteration_ratio": {"measured": ratio, "target": TARGETS["iteration_ratio"]},
             "beyond_g_max": {"measured": b["beyond_g_max"], "target": TARGETS["beyond_g_max"]},
+            "beyond_task_g_max": {
+                "measured": b["beyond_task_g_max"],
+                "target": TARGETS["beyond_g_max"],
+            },
         }
         print(
             f"targets ({best}): median solve {b['median_solve_s']:.3f} s wall, "

@@ -103,17 +103,40 @@ def test_killed_run_resumes_to_the_same_dataset(tmp_path: Path) -> None:
         generate(SPEC, SPACE, 4, tmp_path / "resumed", seed=1, progress=None)
 
 
-def test_a_run_is_not_resumed_under_another_constraint_set(tmp_path: Path, monkeypatch) -> None:
+def test_a_run_is_not_resumed_under_another_constraint_set(tmp_path: Path) -> None:
     """Solves of a problem with other constraints must not be mixed into the run."""
     from dataclasses import replace
 
+    from roughwalk.trajopt.parameters import MELON_CONSTRAINTS
+
     generate(SPEC, SPACE, 0, tmp_path / "run", progress=None)
-    original = ProblemSpec.config
-
-    def with_reach(self: ProblemSpec):  # type: ignore[no-untyped-def]
-        cfg = original(self)
-        return replace(cfg, constraints=(*cfg.constraints, "leg_reach"))
-
-    monkeypatch.setattr(ProblemSpec, "config", with_reach)
+    without_reach = replace(SPEC, constraints=MELON_CONSTRAINTS)
     with pytest.raises(ConfigError, match="another 'constraints'"):
-        generate(SPEC, SPACE, 0, tmp_path / "run", progress=None)
+        generate(without_reach, SPACE, 0, tmp_path / "run", progress=None)
+
+
+def test_generate_selects_the_constraint_set(tmp_path: Path) -> None:
+    """``init generate --constraints`` builds (and records) the NLP with the named set."""
+    from roughwalk.cli.main import main
+    from roughwalk.learning.problem_spec import build_problem, constraint_set
+    from roughwalk.trajopt.parameters import MELON_CONSTRAINTS, MELON_REACH_CONSTRAINTS
+
+    common = ["init", "generate", "--env", "flat", "--steps", "4", "--duration", "2.0"]
+    for name, expected in (("melon", MELON_CONSTRAINTS), (None, MELON_REACH_CONSTRAINTS)):
+        out = tmp_path / str(name)
+        extra = [] if name is None else ["--constraints", name]
+        assert main([*common, "--tasks", "0", "--out", str(out), *extra]) == 0
+        meta = json.loads((out / "run.json").read_text())
+        assert meta["constraints"] == list(expected)
+        spec = ProblemSpec.from_dict(meta["problem"])
+        assert spec.config().constraints == expected
+        assert ProblemSpec.from_dict(spec.to_dict()) == spec
+    # The reach ball adds rows: the two sets are two problems.
+    with_reach = build_problem(ProblemSpec("anymal_c", "flat", "walk", 4, 2.0))
+    without = build_problem(
+        ProblemSpec("anymal_c", "flat", "walk", 4, 2.0, False, MELON_CONSTRAINTS)
+    )
+    assert with_reach.formulation.n_constraints > without.formulation.n_constraints
+    assert constraint_set("terrain,dynamics") == ("terrain", "dynamics")
+    with pytest.raises(ConfigError, match="unknown constraint set or names 'reach'"):
+        constraint_set("reach")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import zipfile
 from pathlib import Path
@@ -140,3 +141,23 @@ def test_multipliers_of_a_constraint_added_after_training_start_at_zero() -> Non
     # Not on a block boundary: left as it is, so the solver drops the mismatched multipliers.
     assert _complete_rows(nlp, lam[:7]).size == 7  # type: ignore[arg-type]
     assert _complete_rows(nlp, np.ones(12)).size == 12  # type: ignore[arg-type]
+
+
+def test_task_cost_model_flags_minima_above_their_task_s_cost_not_costly_tasks() -> None:
+    """Far starts cost more: the per-task fence passes them and catches a poor minimum."""
+    from roughwalk.learning import TaskCostModel
+
+    rng = np.random.default_rng(0)
+    starts = rng.uniform([-0.5, -0.75, -0.5], [0.5, 0.75, 0.5], size=(300, 3))
+    tasks = np.column_stack([starts, np.tile([1.6, 0.0, 0.0], (300, 1))])
+    cost = np.exp(0.5 - 0.8 * starts[:, 0] + 0.3 * starts[:, 1] ** 2) * rng.lognormal(0, 0.03, 300)
+    poor = np.arange(300) % 25 == 0
+    cost[poor] *= 2.0  # poor local minima, anywhere in the task space
+    model = TaskCostModel.fit(tasks, cost)
+    beyond = cost > model.threshold(tasks)
+    assert beyond[poor].all() and beyond[~poor].mean() <= 0.01
+    # A global threshold misses the poor minima of cheap (near) starts.
+    global_beyond = cost > cost_threshold(cost)
+    assert global_beyond[poor].sum() < poor.sum() // 2
+    back = TaskCostModel.from_dict(json.loads(json.dumps(model.to_dict())))
+    assert np.allclose(back.threshold(tasks), model.threshold(tasks))

@@ -59,6 +59,23 @@ def test_keeps_anymal_c_standing_under_a_50_n_lateral_push(robot):
     assert pushed.max_orientation_error_rad < 0.1
 
 
+def test_a_stalled_qp_tick_ends_the_run_as_a_reported_failure(robot):
+    """A solver that hits its iteration limit stops the run at once, named as the reason."""
+    ns = robot.nominal_stance
+    base = np.array([0.0, 0.0, ns.base_height])
+    feet = ns.feet + base - [0.0, 0.0, robot.foot_radius]
+    reference = Reference.standing(base, feet, robot.mass, duration=0.5)
+    fine = execute_reference(reference, robot, load_terrain("flat"), TrackingConfig())
+    assert fine.success, fine.reason
+    # One proxqp outer iteration cannot reach 1e-8: every tick stalls.
+    starved = TrackingConfig(qp_max_iter=1)
+    outcome = execute_reference(reference, robot, load_terrain("flat"), starved)
+    assert not outcome.success and not outcome.fell
+    assert outcome.reason.startswith("the whole-body QP stalled at t = 0.00 s"), outcome.reason
+    assert "iteration limit (1)" in outcome.reason
+    assert outcome.simulated_s == 0.0 and outcome.qp_failures == 1
+
+
 def test_tracks_an_optimised_flat_ground_trot_to_the_goal_within_5_cm(trot):
     # A trot with flight phases is chaotic in simulation: numpy's and proxsuite's
     # reductions round by memory alignment, so two runs differ at 1e-7 and, about

@@ -62,11 +62,11 @@ def test_a_named_body_model_still_names_the_robot_that_executes_it(tmp_path: Pat
     assert data["robot"] == "anymal_c" and data["body_model"] == "towr_anymal"
 
 
-def test_leg_reach_flag_adds_the_reach_rows(tmp_path: Path) -> None:
-    """``--leg-reach`` puts the ball-per-leg constraint into the problem; without it, none."""
+def test_leg_reach_is_on_by_default_and_no_leg_reach_drops_its_rows(tmp_path: Path) -> None:
+    """The ball-per-leg constraint is in the default problem; ``--no-leg-reach`` removes it."""
     counts = []
-    for extra in ([], ["--leg-reach"]):
-        out = tmp_path / f"reach{len(extra)}.json"
+    for k, extra in enumerate(([], ["--leg-reach"], ["--no-leg-reach"])):
+        out = tmp_path / f"reach{k}.json"
         main([*FLAGS, "--max-iter", "0", *extra, "--json", str(out)])
         counts.append(json.loads(out.read_text())["n_constraints"])
-    assert counts[1] > counts[0]
+    assert counts[0] == counts[1] > counts[2]

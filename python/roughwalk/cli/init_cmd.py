@@ -32,6 +32,11 @@ def _problem_args(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--optimize-durations", action="store_true", help="optimise the phase durations too"
     )
+    p.add_argument(
+        "--constraints",
+        help="constraint set: melon, melon_reach (the default set) or towr, or "
+        "comma-separated constraint names",
+    )
 
 
 def _executor_args(p: argparse.ArgumentParser) -> None:
@@ -107,11 +112,17 @@ def cmd_generate(args: argparse.Namespace) -> int:
     """Solve ``--tasks`` sampled tasks into a resumable run folder."""
     from roughwalk.learning.executors import make_executor
     from roughwalk.learning.experience import N_HEURISTIC, generate
-    from roughwalk.learning.problem_spec import ProblemSpec
+    from roughwalk.learning.problem_spec import ProblemSpec, constraint_set
 
     space = _space(args)
     spec = ProblemSpec(
-        args.robot, space.terrain, args.gait, args.steps, args.duration, args.optimize_durations
+        args.robot,
+        space.terrain,
+        args.gait,
+        args.steps,
+        args.duration,
+        args.optimize_durations,
+        None if args.constraints is None else constraint_set(args.constraints),
     )
     out = args.out or DEFAULT_ROOT / f"{space.name}_{args.gait}{args.steps}_{args.split}"
     model = None

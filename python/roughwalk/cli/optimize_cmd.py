@@ -43,9 +43,10 @@ def register(sub: Any) -> None:
     )
     p.add_argument(
         "--leg-reach",
-        action="store_true",
-        help="also keep every foot within its leg's real reach (a ball per leg; "
-        "off by default until the shipped learned initialisers are retrained with it)",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="keep every foot within its leg's real reach (a ball per leg; on by "
+        "default, --no-leg-reach leaves TOWR's box alone)",
     )
     add_output_args(p, picture=True, npz=True)
     p.set_defaults(func=cmd_optimize)
@@ -75,6 +76,8 @@ def cmd_optimize(args: argparse.Namespace) -> int:
         overrides["solver__max_iter"] = args.max_iter
     if args.leg_reach and "leg_reach" not in config.constraints:
         overrides["constraints"] = (*config.constraints, "leg_reach")
+    elif args.leg_reach is False:
+        overrides["constraints"] = tuple(c for c in config.constraints if c != "leg_reach")
     robot = load_robot(args.robot) if config.body_model == "robot" else None
     terrain = load_terrain(args.terrain)
     task = Task(parse_pose(args.start, "--start"), parse_pose(args.goal, "--goal"))

@@ -16,6 +16,7 @@ from roughwalk.learning.initializer import LearnedInitializer, load_model, shipp
 from roughwalk.learning.iterate import RoundReport, learned_init_rounds
 from roughwalk.learning.model_file import LearnedModel
 from roughwalk.learning.problem_spec import ProblemSpec, build_problem, variable_layout
+from roughwalk.learning.task_cost_model import TaskCostModel
 from roughwalk.learning.task_space import ENVIRONMENTS, TaskSpace, task_space
 from roughwalk.learning.training import CATEGORY_WEIGHTS, TrainReport, train_model
 
@@ -38,6 +39,7 @@ __all__ = [
     "FilterResult",
     "cost_threshold",
     "filter_good",
+    "TaskCostModel",
     "CATEGORY_WEIGHTS",
     "TrainReport",
     "train_model",

@@ -287,10 +287,10 @@ def generate(
     run = ExperienceRun(
         folder,
         {
-            "problem": spec.to_dict(),
-            # The constraint set is not part of the spec (models predate it), but a
-            # run resumed under another set would mix two problems' solves.
+            # A run resumed under another constraint set would mix two problems'
+            # solves; checked first, so that the refusal names it.
             "constraints": list(spec.config().constraints),
+            "problem": spec.to_dict(),
             "task_space": space.to_dict(),
             "split": split,
             "seed": seed,

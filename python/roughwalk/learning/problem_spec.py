@@ -24,9 +24,28 @@ from roughwalk.trajopt import (
     melon_config,
     rigid_body_model,
 )
+from roughwalk.trajopt.parameters import (
+    MELON_CONSTRAINTS,
+    MELON_REACH_CONSTRAINTS,
+    TOWR_CONSTRAINTS,
+)
 from roughwalk.trajopt.terrain_model import TerrainModel
 
-__all__ = ["ProblemSpec", "build_problem", "variable_layout", "variable_categories"]
+__all__ = [
+    "ProblemSpec",
+    "CONSTRAINT_SETS",
+    "constraint_set",
+    "build_problem",
+    "variable_layout",
+    "variable_categories",
+]
+
+CONSTRAINT_SETS: dict[str, tuple[str, ...]] = {
+    "melon": MELON_CONSTRAINTS,
+    "melon_reach": MELON_REACH_CONSTRAINTS,
+    "towr": TOWR_CONSTRAINTS,
+}
+"""Named constraint sets (``roughwalk init generate --constraints NAME``)."""
 
 _problems: dict[ProblemSpec, TrajoptProblem] = {}
 
@@ -49,6 +68,10 @@ class ProblemSpec:
         Total duration T [s].
     optimize_durations:
         Whether the phase durations are optimised (else fixed at the gait's).
+    constraints:
+        The NLP's constraint names; None: :func:`~roughwalk.trajopt.melon_config`'s
+        default set (left out of :meth:`to_dict` then, so that runs recorded
+        before the field existed still resume).
 
     """
 
@@ -58,19 +81,29 @@ class ProblemSpec:
     steps: int = 16
     duration: float = 5.5
     optimize_durations: bool = False
+    constraints: tuple[str, ...] | None = None
 
     def config(self) -> TrajoptConfig:
         """Melon et al.'s configuration for this problem."""
+        changes: dict[str, object] = {}
+        if self.constraints is not None:
+            changes["constraints"] = tuple(self.constraints)
         return melon_config(
             gait=self.gait,
             steps=self.steps,
             duration=self.duration,
             optimize_durations=self.optimize_durations,
+            **changes,
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data for JSON."""
-        return asdict(self)
+        """Plain data for JSON (``constraints`` only when not the default set)."""
+        data = asdict(self)
+        if self.constraints is None:
+            del data["constraints"]
+        else:
+            data["constraints"] = list(self.constraints)
+        return data
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> ProblemSpec:
@@ -83,9 +116,29 @@ class ProblemSpec:
                 steps=int(data["steps"]),
                 duration=float(data["duration"]),
                 optimize_durations=bool(data["optimize_durations"]),
+                constraints=None
+                if data.get("constraints") is None
+                else tuple(str(c) for c in data["constraints"]),
             )
         except KeyError as e:
             raise ConfigError(f"problem spec lacks the field {e}; got {sorted(data)}") from None
+
+
+def constraint_set(text: str) -> tuple[str, ...]:
+    """A named set (:data:`CONSTRAINT_SETS`) or comma-separated constraint names."""
+    from roughwalk.trajopt.constraints import constraint_names
+
+    if text in CONSTRAINT_SETS:
+        return CONSTRAINT_SETS[text]
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    known = constraint_names()
+    unknown = [n for n in names if n not in known]
+    if unknown or not names:
+        raise ConfigError(
+            f"unknown constraint set or names {text!r}: give one of "
+            f"{', '.join(CONSTRAINT_SETS)} or names among {', '.join(sorted(known))}"
+        )
+    return names
 
 
 def build_problem(spec: ProblemSpec) -> TrajoptProblem:

@@ -26,6 +26,7 @@ from roughwalk.learning.filtering import filter_good
 from roughwalk.learning.mlp import MLP
 from roughwalk.learning.model_file import FEATURES, MODEL_FORMAT, MODEL_VERSION, LearnedModel
 from roughwalk.learning.problem_spec import ProblemSpec, build_problem, variable_categories
+from roughwalk.learning.task_cost_model import TaskCostModel
 
 __all__ = [
     "CATEGORY_WEIGHTS",
@@ -256,6 +257,7 @@ def train_model(
         "format": MODEL_FORMAT,
         "version": MODEL_VERSION,
         "problem": spec.to_dict(),
+        "constraints": data.meta.get("constraints"),
         "task_space": data.meta.get("task_space"),
         "layout": [list(item) for item in data.meta["layout"]],
         "features": list(FEATURES),
@@ -274,6 +276,7 @@ def train_model(
             "g_max_automatic": report.automatic,
             "fit_seed": seed,
             "rmse": rmse,
+            "task_cost_model": _task_cost_model(data, result.feasible),
             "note": note,
         },
         "multipliers": {
@@ -286,6 +289,15 @@ def train_model(
         **(dict(extra) if extra else {}),
     }
     return LearnedModel(mlp, header, multiplier_mlp), report
+
+
+def _task_cost_model(data: Dataset, feasible: NDArray[np.bool_]) -> dict[str, Any] | None:
+    """A per-task g_max (:class:`TaskCostModel`) from the feasible solutions, if enough."""
+    tasks = np.column_stack([data["start"], data["goal"]])[feasible]
+    try:
+        return TaskCostModel.fit(tasks, data["cost"][feasible]).to_dict()
+    except InvalidArgumentError:
+        return None
 
 
 def _fit_multipliers(

@@ -192,6 +192,11 @@ class TrackingConfig:
         Bounds [N] on a stance foot's normal force.
     qp_solver:
         qpsolvers' name of the QP solver ("proxqp", "osqp", ...).
+    qp_max_iter:
+        The QP solver's iteration limit (None: the solver's default in
+        :class:`~roughwalk.tracking.whole_body_qp.WholeBodyQP`). A tick that
+        hits it stalls, and a stalled tick ends the run as a failure: a
+        400 Hz controller has no minutes to spend on one solve.
     hard_contacts:
         Stance feet do not accelerate as a hard constraint of the QP
         (Bellicoso et al.'s highest priority) instead of a heavy task.
@@ -236,6 +241,7 @@ class TrackingConfig:
     min_normal_force_n: float = 2.0
     max_normal_force_n: float = 1500.0
     qp_solver: str = "proxqp"
+    qp_max_iter: int | None = None
     track_com: bool = False
     hard_contacts: bool = True
     reach_aware: bool = True

@@ -163,6 +163,7 @@ class WholeBodyController:
             cfg.min_normal_force_n,
             cfg.max_normal_force_n,
             cfg.qp_solver,
+            cfg.qp_max_iter,
         )
         self.contact = ContactStateMachine(cfg.contact)
         m = world.model
@@ -171,6 +172,7 @@ class WholeBodyController:
         self.foot_radius = float(world.robot.foot_radius)
         self.torques = np.zeros(len(world.joint_dof))
         self.qp_failures = 0
+        self.qp_stalls = 0
         self._mass = np.zeros((self.nv, self.nv))
         self._jacp = np.zeros((3, self.nv))
         self._jacdot = np.zeros((3, self.nv))
@@ -237,6 +239,7 @@ class WholeBodyController:
             qp_forces[stance] = solution.forces
         else:
             self.qp_failures += 1
+            self.qp_stalls += int(solution.stalled)
         d.ctrl[world.actuator_of_joint] = self.torques
         return ControlTick(
             state,

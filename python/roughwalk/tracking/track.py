@@ -182,6 +182,7 @@ def _simulate(
     n_ticks = int(math.ceil((reference.duration + cfg.stand_after_s) / dt - 1e-9)) + 1
     rows: dict[str, list[Any]] = {k: [] for k in TrackingLog.__dataclass_fields__}
     fell_at: float | None = None
+    stalled_at: float | None = None
     reason = ""
     qp_time = 0.0
     cpu_time = 0.0
@@ -218,7 +219,13 @@ def _simulate(
                 f"fell: roll {math.degrees(roll):.0f}°, pitch {math.degrees(pitch):.0f}° at "
                 f"t = {t:.2f} s (limit {math.degrees(cfg.max_roll_pitch_rad):.0f}°)"
             )
-        if fell_at is not None:
+        if fell_at is None and tick.solution.stalled:
+            stalled_at = t
+            reason = (
+                f"the whole-body QP stalled at t = {t:.2f} s: {controller.config.qp_solver} "
+                f"reached its iteration limit ({controller.qp.max_iter}) without a solution"
+            )
+        if fell_at is not None or stalled_at is not None:
             break
         if push is not None:
             d.xfrc_applied[world.base_body, :3] = push.force_n if push.active(t) else 0.0
@@ -229,7 +236,7 @@ def _simulate(
     log = TrackingLog(**{k: np.asarray(v) for k, v in rows.items()})
     final = reference(reference.duration)
     final_error = float(np.linalg.norm(log.base_pos[-1] - final.base_pos))
-    if fell_at is None:
+    if fell_at is None and stalled_at is None:
         tol = cfg.final_position_tolerance_m
         ok = final_error <= tol
         reason = (

@@ -43,6 +43,9 @@ class QPSolution:
         (n_contacts, 3) contact forces on the stance feet [N], world axes.
     x:
         The solution vector [q̈, τ, f].
+    stalled:
+        The solver stopped at its iteration limit without a solution (a tick
+        a 400 Hz controller cannot afford; ``success`` is False then).
     """
 
     success: bool
@@ -50,6 +53,7 @@ class QPSolution:
     tau: NDArray[np.float64]
     forces: NDArray[np.float64]
     x: NDArray[np.float64]
+    stalled: bool = False
 
 
 def friction_pyramid(normal: ArrayLike, friction: float) -> NDArray[np.float64]:
@@ -86,6 +90,12 @@ class WholeBodyQP:
         Bounds [N] of each stance foot's normal force.
     solver:
         qpsolvers' solver name ("proxqp", "osqp", ...).
+    max_iter:
+        The solver's iteration limit (proxqp: outer iterations, and as many
+        at most 100 inner ones each; osqp: ADMM iterations); None: 1000 for
+        proxqp, 20000 for osqp. proxqp's own limits (10⁴ × 1500) let one
+        ill-conditioned tick run for minutes; a tick that hits the limit is
+        reported as stalled.
     """
 
     def __init__(
@@ -96,6 +106,7 @@ class WholeBodyQP:
         min_normal_force: float = 0.0,
         max_normal_force: float = np.inf,
         solver: str = "proxqp",
+        max_iter: int | None = None,
     ) -> None:
         import qpsolvers
 
@@ -114,8 +125,10 @@ class WholeBodyQP:
         self.friction = float(friction)
         self.min_normal_force = float(min_normal_force)
         self.max_normal_force = float(max_normal_force)
+        if max_iter is not None and max_iter < 1:
+            raise ConfigError(f"the QP's max_iter must be ≥ 1, got {max_iter}")
         self.solver = solver
-        self._solve_qp = qpsolvers.solve_qp
+        self.max_iter = _DEFAULT_MAX_ITER.get(solver, 1000) if max_iter is None else int(max_iter)
 
     def layout(self, nv: int, n_contacts: int) -> QPLayout:
         """The unknowns' layout for a model of ``nv`` DoF with ``n_contacts`` stance feet."""
@@ -211,31 +224,96 @@ class WholeBodyQP:
         b_all = np.concatenate([r * task.target for r, task in zip(roots, tasks, strict=True)])
         p = a_all.T @ a_all + 1e-9 * np.eye(n)
         q = -(a_all.T @ b_all)
-        options = _solver_options(self.solver)
         x = None
         if qacc_bounds is not None:
             lb = np.full(n, -np.inf)
             ub = np.full(n, np.inf)
             lb[lay.qacc] = qacc_bounds[0]
             ub[lay.qacc] = qacc_bounds[1]
-            x = self._solve_qp(
-                p, q, G=g, h=g_h, A=a_eq, b=b_eq, lb=lb, ub=ub, solver=self.solver, **options
-            )
-        if x is None or not np.all(np.isfinite(x)):
-            x = self._solve_qp(p, q, G=g, h=g_h, A=a_eq, b=b_eq, solver=self.solver, **options)
-        if x is None or not np.all(np.isfinite(x)):
+            x, _ = self._solve_qp(p, q, g, g_h, a_eq, b_eq, lb, ub)
+        stalled = False
+        if x is None:
+            x, stalled = self._solve_qp(p, q, g, g_h, a_eq, b_eq, None, None)
+        if x is None:
             zero = np.zeros(n)
-            return QPSolution(False, zero[lay.qacc], zero[lay.tau], np.zeros((nc, 3)), zero)
+            return QPSolution(
+                False, zero[lay.qacc], zero[lay.tau], np.zeros((nc, 3)), zero, stalled
+            )
         x = np.asarray(x, dtype=float)
         forces = x[nv + lay.nu :].reshape(nc, 3)
         return QPSolution(True, x[lay.qacc].copy(), x[lay.tau].copy(), forces.copy(), x)
 
+    def _solve_qp(
+        self,
+        p: NDArray[np.float64],
+        q: NDArray[np.float64],
+        g: NDArray[np.float64],
+        g_h: NDArray[np.float64],
+        a_eq: NDArray[np.float64],
+        b_eq: NDArray[np.float64],
+        lb: NDArray[np.float64] | None,
+        ub: NDArray[np.float64] | None,
+    ) -> tuple[NDArray[np.float64] | None, bool]:
+        """(x or None, whether the solver stopped at its iteration limit)."""
+        if self.solver == "proxqp":
+            return self._solve_proxqp(p, q, g, g_h, a_eq, b_eq, lb, ub)
+        import qpsolvers
 
-def _solver_options(solver: str) -> dict[str, Any]:
-    # Tight tolerances: the torques are applied as solved, and a loose
-    # equality would be a force error the base feels.
-    if solver == "proxqp":
-        return {"eps_abs": 1e-8, "eps_rel": 0.0}
+        problem = qpsolvers.Problem(p, q, g, g_h, a_eq, b_eq, lb, ub)
+        options = _solver_options(self.solver, self.max_iter)
+        solution = qpsolvers.solve_problem(problem, solver=self.solver, **options)
+        x = solution.x
+        if solution.found and x is not None and np.all(np.isfinite(x)):
+            return np.asarray(x, dtype=float), False
+        info = solution.extras.get("info")
+        return None, "maximum iterations" in str(getattr(info, "status", "")).lower()
+
+    def _solve_proxqp(
+        self,
+        p: NDArray[np.float64],
+        q: NDArray[np.float64],
+        g: NDArray[np.float64],
+        g_h: NDArray[np.float64],
+        a_eq: NDArray[np.float64],
+        b_eq: NDArray[np.float64],
+        lb: NDArray[np.float64] | None,
+        ub: NDArray[np.float64] | None,
+    ) -> tuple[NDArray[np.float64] | None, bool]:
+        """Solve with proxqp directly: qpsolvers cannot set its inner iteration limit."""
+        from proxsuite import proxqp
+
+        n = q.size
+        c, lower, upper = g, np.full(g_h.size, -np.inf), g_h
+        if lb is not None and ub is not None:
+            bounded = np.isfinite(lb) | np.isfinite(ub)
+            c = np.vstack([g, np.eye(n)[bounded]])
+            lower = np.concatenate([lower, lb[bounded]])
+            upper = np.concatenate([upper, ub[bounded]])
+        solver = proxqp.dense.QP(n, a_eq.shape[0], c.shape[0])
+        # Tight tolerances: the torques are applied as solved, and a loose
+        # equality would be a force error the base feels.
+        solver.settings.eps_abs = 1e-8
+        solver.settings.eps_rel = 0.0
+        solver.settings.max_iter = self.max_iter
+        solver.settings.max_iter_in = _PROXQP_MAX_ITER_IN
+        solver.settings.verbose = False
+        solver.init(p, q, a_eq, b_eq, c, lower, upper)
+        solver.solve()
+        status = solver.results.info.status
+        x = np.array(solver.results.x, dtype=float)
+        if status == proxqp.QPSolverOutput.PROXQP_SOLVED and np.all(np.isfinite(x)):
+            return x, False
+        return None, bool(status == proxqp.QPSolverOutput.PROXQP_MAX_ITER_REACHED)
+
+
+# proxqp's outer iterations: the whole-body QP takes 5–150, each with a few inner
+# ones; 1000 × 100 bounds a tick to about a second of CPU in the worst case
+# (proxqp's own limits, 10⁴ × 1500, to minutes).
+_DEFAULT_MAX_ITER = {"proxqp": 1000, "osqp": 20000}
+_PROXQP_MAX_ITER_IN = 100
+
+
+def _solver_options(solver: str, max_iter: int) -> dict[str, Any]:
     if solver == "osqp":
-        return {"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iter": 20000, "polish": True}
+        return {"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iter": max_iter, "polish": True}
     return {}

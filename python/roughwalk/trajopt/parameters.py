@@ -3,7 +3,8 @@
 Two presets cover the papers:
 
 * :func:`melon_config` (the default): TOWR's constraints plus Melon et al.'s
-  additions (base above the feet, swing height and apex) and analytic costs
+  additions (base above the feet, swing height and apex), the legs' reach
+  ball, and analytic costs
   (Melon 2020, §III-A);
 * :func:`towr_config`: TOWR 1.4's default problem, a pure feasibility problem
   with its constraints only and its ANYmal parameters, so that timings can be
@@ -55,14 +56,11 @@ MELON_CONSTRAINTS: tuple[str, ...] = (
 MELON_REACH_CONSTRAINTS: tuple[str, ...] = (*MELON_CONSTRAINTS, "leg_reach")
 """:data:`MELON_CONSTRAINTS` plus the legs' real reach (a ball per leg, for bodies that know it).
 
-Plans made with it keep every stance foot within reach of the planned base
-(single pallet: 0.1 % of 10 ms samples out of reach against 39 % with the
-box alone). Not the default yet: the shipped learned initialisers were
-trained without it, and their guesses need 48 instead of 13 median
-iterations on the held-out single-pallet tasks when it is on (``roughwalk
-bench init``). Turn it on with ``melon_config(constraints=MELON_REACH_CONSTRAINTS)``
-or ``roughwalk optimize --leg-reach``; it becomes the default when the
-models are retrained on it.
+The default set of :func:`melon_config`: plans made with it keep every
+stance foot within reach of the planned base (single pallet: 0.1 % of 10 ms
+samples out of reach against 39 % with the box alone), and the shipped
+learned initialisers are trained on it. ``melon_config(constraints=
+MELON_CONSTRAINTS)`` gives the box alone.
 """
 
 
@@ -398,7 +396,7 @@ class TrajoptConfig:
     force_polys_per_stance: int = 3
     dt_dynamics: float = 0.1
     dt_range_of_motion: float = 0.08
-    constraints: tuple[str, ...] = MELON_CONSTRAINTS
+    constraints: tuple[str, ...] = MELON_REACH_CONSTRAINTS
     costs: CostWeights = field(default_factory=CostWeights)
     swing_clearance: float = 0.08
     base_clearance: float = 0.7
