@@ -28,6 +28,7 @@ velocity-only time-optimal law, smoothed at its ends by the same ramps).
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -245,7 +246,25 @@ class SwingSpline:
         lift = s + f * (t - s)
         drop = t - f * (t - s)
         lift[2] = drop[2] = top
-        return cls(np.array([s, lift, drop, t]), duration, config, leg_angles, velocity_limit)
+        waypoints = np.array([s, lift, drop, t])
+        spline = cls(waypoints, duration, config, leg_angles, velocity_limit)
+        if config.time_law != "joint" or leg_angles is None or velocity_limit is None:
+            return spline
+        # Where the leg's IK is nearly singular along the path (a high swing
+        # over rocks at the edge of the workspace) its rate is a poor metric:
+        # keep whichever law lets the joints' peak speeds allow the shorter swing.
+        even = cls(waypoints, duration, replace(config, time_law="even"))
+        return min((spline, even), key=lambda c: c.least_time(leg_angles, velocity_limit))
+
+    def least_time(self, leg_angles: LegAngles, velocity_limit: ArrayLike) -> float:
+        """Least duration [s] at which this path and time law keep the leg within its limits.
+
+        The peak of |q̇_j| / v_j over 41 samples, times the current duration.
+        """
+        q = np.asarray(leg_angles(self.position(np.linspace(0.0, self.duration, 41))))
+        v = np.asarray(velocity_limit, dtype=float).reshape(3)
+        peak = np.abs(np.diff(q, axis=0)).max(axis=0) * 40 / self.duration
+        return float(np.max(peak / v)) * self.duration
 
     def _segments(
         self, t: ArrayLike
