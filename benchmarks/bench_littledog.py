@@ -55,6 +55,17 @@ SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "terrains" / "l
 BOARDS = {"large_rocks": "AE", "round_rocks": "AC", "sloped_rocks": "Y", "logs": "AD"}
 CLASSES = ("large_rocks", "round_rocks", "sloped_rocks", "logs", "gap", "barrier", "steps")
 TARGET_CM_S = 7.2
+# A reflex this soon [s] after the first motion counts as the start not holding.
+PLACEMENT_S = 0.1
+# Simulated time [s] of a start probe: the settling hold and the first step's start.
+PROBE_S = 0.5
+# Start offsets (forward [m], sideways [m]) tried in turn until the start
+# stance has a pose certificate. Forward only up to 9 cm left the LittleDog
+# logs board (AD) without a start on seed 0: every stance straddled a log.
+START_NUDGES = sorted(
+    ((dx, dy) for dx in (0.0, 0.03, 0.06, 0.09, 0.12, 0.15) for dy in (0.0, -0.03, 0.03)),
+    key=lambda d: (d[0], abs(d[1]), d[1]),
+)
 
 
 def course(
@@ -77,6 +88,25 @@ def course(
     return spec, start, (0.25 + length, 0.0)
 
 
+def stands_where_put(result: Any) -> bool:
+    """Whether a run's start held: a plan came, and no reflex or fall before the walk began.
+
+    A reflex within :data:`PLACEMENT_S` of the first motion means the trunk
+    had already tilted or slid while the robot settled before the clock
+    started (board Y: a foot put on a steep rock face slid, tipping the trunk
+    12°), which a trial's operator would have seen and fixed.
+    """
+    if result.outcome.reason.startswith("no plan: start stance"):
+        return False
+    first = result.to_dict().get("first_motion_s")
+    for event in result.log.events:
+        if event["kind"] == "fall" and (first is None or event["time"] <= first + PLACEMENT_S):
+            return False
+        if event["kind"] == "reflex" and first is not None and event["time"] <= first + PLACEMENT_S:
+            return False
+    return True
+
+
 def one_run(
     spec: str,
     start: tuple[float, float, float],
@@ -90,26 +120,41 @@ def one_run(
     ``sets``: (dotted key, value) overrides; keys under ``trajectory.`` go to
     trajectory generation, the others to the simulation.
 
-    Where the start stance has no pose certificate (feet on a rock edge), the
-    start moves forward 3 cm at a time, up to three times, as a trial's
-    operator would place the robot.
+    Where the start stance has no pose certificate (feet on a rock edge or
+    a log's flank), the start moves as a trial's operator would place the
+    robot: forward 3 cm at a time up to 15 cm, and at each of those also
+    3 cm to either side (:data:`START_NUDGES`, nearest first). The same
+    where the robot, put down there, does not stand still until its first
+    step (:func:`stands_where_put`, from a short run up to ``PROBE_S``); if no
+    start holds, the first is used.
     """
     sim = {k: v for k, v in sets if not k.startswith("trajectory.")}
     traj = {k.removeprefix("trajectory."): v for k, v in sets if k.startswith("trajectory.")}
     trajectory_config = rw.trajectories.trajectory_config(**traj) if traj else None
     began = time.perf_counter()
-    for shift in (0.0, 0.03, 0.06, 0.09):
-        result = run(
+    chosen = START_NUDGES[0]
+    for dx, dy in START_NUDGES:
+        # Put the robot down and let it settle: a short run up to the first step.
+        probe = run(
             "littledog",
             spec,
-            (start[0] + shift, start[1], start[2]),
+            (start[0] + dx, start[1] + dy, start[2]),
             goal,
-            disturbances=disturbances,
             trajectory_config=trajectory_config,
-            **{"executor.initial_plan_s": plan_time, **sim},
+            **{**sim, "executor.initial_plan_s": 0.5, "outcome.time_limit_s": PROBE_S},
         )
-        if not result.outcome.reason.startswith("no plan: start stance"):
+        if stands_where_put(probe):
+            chosen = (dx, dy)
             break
+    result = run(
+        "littledog",
+        spec,
+        (start[0] + chosen[0], start[1] + chosen[1], start[2]),
+        goal,
+        disturbances=disturbances,
+        trajectory_config=trajectory_config,
+        **{"executor.initial_plan_s": plan_time, **sim},
+    )
     out = result.to_dict()
     out["wall_s"] = time.perf_counter() - began
     out["rescued"] = bool(out["success"] and out["reflexes"] > 0)

@@ -11,6 +11,7 @@ the CoM nudged into the support triangle (§4.4, the support step of the core).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,6 +55,20 @@ class BodyKeyframe:
     def com_offset(self) -> NDArray[np.float64]:
         """(3,) CoM minus base position, world axes [m]."""
         return self.com - self.base_pos
+
+    def leg_angles(
+        self, wb: WholeBody, leg: int
+    ) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
+        """IK of leg ``leg`` (canonical) from this trunk pose: feet (n, 3) [m] → (n, 3) [rad]."""
+        rot = self.rotation
+        held = (self.feet - self.base_pos) @ rot
+
+        def angles(points: NDArray[np.float64]) -> NDArray[np.float64]:
+            feet_b = np.repeat(held[None], len(points), axis=0)
+            feet_b[:, leg] = (np.asarray(points, dtype=float) - self.base_pos) @ rot
+            return wb.inverse_kinematics(feet_b)[0][:, leg]
+
+        return angles
 
     def translated(self, wb: WholeBody, shift: ArrayLike) -> BodyKeyframe:
         """The same orientation with the trunk moved by ``shift`` (3,) [m], feet re-solved."""

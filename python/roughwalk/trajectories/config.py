@@ -172,6 +172,12 @@ class SwingConfig:
         other side swings, the trunk rolls over the feet it is pushed
         towards), and the sweep's default 1.6–3.2 s window misses those of
         "knots" (9/9 both ways; "even" 9/9 and 7/9).
+        ``"joint"``: as ``"even"``, but the pace along the path is the swing
+        leg's own, the largest joint speed over its limit (the
+        velocity-limited time-optimal law with the same end ramps), where the
+        leg's inverse kinematics is given; else it is ``"even"``. On a flat
+        LittleDog stride of 6–10 cm the least swing drops by ~16 %
+        (0.274 → 0.231 s at 9.4 cm).
     vertical_weight:
         With ``"even"``: one metre of vertical foot motion counts like this
         many metres of horizontal motion (LittleDog's hip and knee turn about
@@ -195,8 +201,10 @@ class SwingConfig:
         _check_nonnegative(self, ("lift_height", "clearance"), "swing")
         if not (math.isfinite(self.lift_fraction) and 0 <= self.lift_fraction < 0.5):
             raise ConfigError(f"swing.lift_fraction must be in [0, 0.5), got {self.lift_fraction}")
-        if self.time_law not in ("even", "knots"):
-            raise ConfigError(f"swing.time_law must be 'even' or 'knots', got {self.time_law!r}")
+        if self.time_law not in ("even", "joint", "knots"):
+            raise ConfigError(
+                f"swing.time_law must be 'even', 'joint' or 'knots', got {self.time_law!r}"
+            )
         _check_positive(self, ("vertical_weight",), "swing")
         if not (math.isfinite(self.ramp_fraction) and 0 < self.ramp_fraction <= 0.5):
             raise ConfigError(f"swing.ramp_fraction must be in (0, 0.5], got {self.ramp_fraction}")

@@ -186,6 +186,8 @@ class FootstepTrajectoryGenerator:
                 self.config.swing,
                 self.terrain,
                 self.robot.foot_radius,
+                leg_angles=pose.leg_angles(self.wb, step.leg),
+                velocity_limit=self.wb.velocity_limit[step.leg],
             )
             path = spline.position(np.linspace(0.0, 1.0, 41))
             legs_b = np.repeat(

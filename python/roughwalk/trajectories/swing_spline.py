@@ -18,10 +18,17 @@ the same path is re-timed so the foot moves at a steady speed in a metric
 that weights vertical motion by ``vertical_weight`` (lifting the foot costs
 LittleDog's hip and knee more than moving it forward), with smooth
 start-up and slow-down over ``ramp_fraction`` of the time at each end.
+With ``time_law = "joint"`` and the swing leg's inverse kinematics at hand,
+the metric is the leg's own: at each point the largest joint speed over its
+limit, max_j |dq_j/du| / v_j, so the limiting joint runs near its limit along
+the whole path instead of only where the Cartesian metric peaks (the
+velocity-only time-optimal law, smoothed at its ends by the same ramps).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -34,7 +41,10 @@ from roughwalk.trajectories.config import SwingConfig
 if TYPE_CHECKING:
     from roughwalk.terrain.terrain import Terrain
 
-__all__ = ["SwingSpline", "ramp_profile"]
+__all__ = ["LegAngles", "SwingSpline", "ramp_profile"]
+
+LegAngles = Callable[[NDArray[np.float64]], NDArray[np.float64]]
+"""The swing leg's angles (n, 3) [rad] with its foot at world positions (n, 3) [m]."""
 
 _TABLE = 2001
 """Samples of the path parameter used to invert its arc length."""
@@ -42,6 +52,8 @@ _NODES = 121
 """Nodes of the cubic time law u(t)."""
 _STOP_SHARE = 0.1
 """Share of the mean weighted speed added to it everywhere (see ``_even_law``)."""
+_JOINT_TABLE = 201
+"""Samples of the path at which the "joint" time law evaluates the leg's IK."""
 
 
 def ramp_profile(tau: ArrayLike, ramp: float) -> NDArray[np.float64]:
@@ -97,9 +109,13 @@ class SwingSpline:
     duration:
         Time [s] from start to target.
     config:
-        With ``time_law == "even"``, the path is re-timed to a steady speed
-        (see the module notes); otherwise (or without it) each segment takes
-        time in proportion to its length.
+        With ``time_law == "even"`` or ``"joint"``, the path is re-timed to a
+        steady speed (see the module notes); otherwise (or without it) each
+        segment takes time in proportion to its length.
+    leg_angles, velocity_limit:
+        The swing leg's IK (:data:`LegAngles`) and its joints' limits (3,)
+        [rad/s], for ``time_law == "joint"``; without them that law falls
+        back to ``"even"``.
 
     Attributes
     ----------
@@ -108,7 +124,12 @@ class SwingSpline:
     """
 
     def __init__(
-        self, waypoints: ArrayLike, duration: float, config: SwingConfig | None = None
+        self,
+        waypoints: ArrayLike,
+        duration: float,
+        config: SwingConfig | None = None,
+        leg_angles: LegAngles | None = None,
+        velocity_limit: ArrayLike | None = None,
     ) -> None:
         p = np.asarray(waypoints, dtype=float)
         if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 2 or not np.all(np.isfinite(p)):
@@ -125,16 +146,40 @@ class SwingSpline:
         self.velocities = _interior_slopes(p, self.knots)
         self._law: CubicSpline | None = None
         self.times = self.knots
-        if config is not None and config.time_law == "even":
-            self._law = self._even_law(config.vertical_weight, config.ramp_fraction)
+        joint_metric = None
+        if leg_angles is not None and velocity_limit is not None:
+            joint_metric = (leg_angles, np.asarray(velocity_limit, dtype=float).reshape(3))
+        if config is not None and config.time_law in ("even", "joint"):
+            self._law = self._even_law(
+                config.vertical_weight,
+                config.ramp_fraction,
+                joint_metric if config.time_law == "joint" else None,
+            )
             if self._law is not None:
                 self.times = self._pass_times()
 
-    def _even_law(self, vertical_weight: float, ramp: float) -> CubicSpline | None:
-        """The path parameter u(t) [s] for a steady weighted speed, or None (keep the knots)."""
+    def _even_law(
+        self,
+        vertical_weight: float,
+        ramp: float,
+        joint_metric: tuple[LegAngles, NDArray[np.float64]] | None = None,
+    ) -> CubicSpline | None:
+        """The path parameter u(t) [s] for a steady weighted speed, or None (keep the knots).
+
+        The weight: the foot's speed with vertical motion counted
+        ``vertical_weight`` times, or with ``joint_metric`` (IK, limits) the
+        largest joint speed over its limit.
+        """
         u = np.linspace(0.0, self.duration, _TABLE)
-        _, du, _ = self._evaluate_path(u)
-        speed = np.linalg.norm(du * [1.0, 1.0, vertical_weight], axis=1)
+        if joint_metric is None:
+            _, du, _ = self._evaluate_path(u)
+            speed = np.linalg.norm(du * [1.0, 1.0, vertical_weight], axis=1)
+        else:
+            leg_angles, limit = joint_metric
+            coarse = np.linspace(0.0, self.duration, _JOINT_TABLE)
+            q = np.asarray(leg_angles(self._evaluate_path(coarse)[0]), dtype=float)
+            rate = np.max(np.abs(np.gradient(q, coarse, axis=0)) / limit, axis=1)
+            speed = np.interp(u, coarse, rate)
         if not np.all(np.isfinite(speed)) or speed.max() <= 0:
             return None
         # A share of the mean keeps the arc length strictly increasing and makes
@@ -171,6 +216,8 @@ class SwingSpline:
         config: SwingConfig,
         terrain: Terrain | None = None,
         foot_radius: float = 0.0,
+        leg_angles: LegAngles | None = None,
+        velocity_limit: ArrayLike | None = None,
     ) -> SwingSpline:
         """The heuristic lift-off and drop-off points, then the spline.
 
@@ -178,7 +225,8 @@ class SwingSpline:
         target, and with ``scan_terrain``, ``clearance`` above the highest
         terrain under the straight path (foot sphere included, sampled across
         the foot's width). They are ``lift_fraction`` of the stride in from
-        start and target.
+        start and target. ``leg_angles`` and ``velocity_limit``: for the
+        ``"joint"`` time law (see the class).
         """
         s = np.asarray(start, dtype=float)
         t = np.asarray(target, dtype=float)
@@ -198,7 +246,25 @@ class SwingSpline:
         lift = s + f * (t - s)
         drop = t - f * (t - s)
         lift[2] = drop[2] = top
-        return cls(np.array([s, lift, drop, t]), duration, config)
+        waypoints = np.array([s, lift, drop, t])
+        spline = cls(waypoints, duration, config, leg_angles, velocity_limit)
+        if config.time_law != "joint" or leg_angles is None or velocity_limit is None:
+            return spline
+        # Where the leg's IK is nearly singular along the path (a high swing
+        # over rocks at the edge of the workspace) its rate is a poor metric:
+        # keep whichever law lets the joints' peak speeds allow the shorter swing.
+        even = cls(waypoints, duration, replace(config, time_law="even"))
+        return min((spline, even), key=lambda c: c.least_time(leg_angles, velocity_limit))
+
+    def least_time(self, leg_angles: LegAngles, velocity_limit: ArrayLike) -> float:
+        """Least duration [s] at which this path and time law keep the leg within its limits.
+
+        The peak of |q̇_j| / v_j over 41 samples, times the current duration.
+        """
+        q = np.asarray(leg_angles(self.position(np.linspace(0.0, self.duration, 41))))
+        v = np.asarray(velocity_limit, dtype=float).reshape(3)
+        peak = np.abs(np.diff(q, axis=0)).max(axis=0) * 40 / self.duration
+        return float(np.max(peak / v)) * self.duration
 
     def _segments(
         self, t: ArrayLike
