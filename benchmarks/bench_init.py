@@ -39,6 +39,7 @@ Writes ``benchmarks/results/init_ENV.json`` and ``init_ENV.png``.
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import statistics
 import time
@@ -339,7 +340,7 @@ def main() -> None:
     if best is not None:
         b = inits[best]
         ratio = heuristic["median_iterations"] / max(b["median_iterations"], 1.0)
-        cpu = times.get(best, {}).get("median_cpu_s", float("nan"))
+        cpu = times.get(best, {}).get("median_cpu_s")  # None without timed tasks
         targets = {
             "initializer": best,
             "median_solve_s": {
@@ -356,8 +357,8 @@ def main() -> None:
         }
         print(
             f"targets ({best}): median solve {b['median_solve_s']:.3f} s wall, "
-            f"{cpu:.3f} s CPU (≤ 0.25), "
-            f"iterations {ratio:.1f}× fewer (≥ 4), beyond g_max {b['beyond_g_max']:.1%} (≤ 1 %)"
+            + (f"{cpu:.3f} s CPU (≤ 0.25), " if cpu is not None else "CPU untimed, ")
+            + f"iterations {ratio:.1f}× fewer (≥ 4), beyond g_max {b['beyond_g_max']:.1%} (≤ 1 %)"
         )
     if table:
         print("Table I (heuristic guess, medians over tasks):")
@@ -371,22 +372,35 @@ def main() -> None:
     out = args.json or RESULTS / f"init_{args.env}.json"
     write_json(
         out,
-        result_envelope(
-            "bench_init",
-            machine=machine_description(),
-            load_average=list(os.getloadavg()),
-            env=args.env,
-            problem=spec.to_dict(),
-            figure_6=fig6,
-            timing=times,
-            table_1=table,
-            targets=targets,
-            wall_s=time.perf_counter() - started,
+        _null_for_nan(
+            result_envelope(
+                "bench_init",
+                machine=machine_description(),
+                load_average=list(os.getloadavg()),
+                env=args.env,
+                problem=spec.to_dict(),
+                figure_6=fig6,
+                timing=times,
+                table_1=table,
+                targets=targets,
+                wall_s=time.perf_counter() - started,
+            )
         ),
     )
     picture = out.with_suffix(".png")
     _plot(fig6, picture, args.env)
     print(f"wrote {out} and {picture}")
+
+
+def _null_for_nan(value: Any) -> Any:
+    """``value`` with every NaN float replaced by None (JSON has no NaN; e.g. no timed tasks)."""
+    if isinstance(value, float) and math.isnan(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _null_for_nan(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_null_for_nan(v) for v in value]
+    return value
 
 
 if __name__ == "__main__":
