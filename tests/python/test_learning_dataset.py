@@ -115,6 +115,19 @@ def test_a_run_is_not_resumed_under_another_constraint_set(tmp_path: Path) -> No
         generate(without_reach, SPACE, 0, tmp_path / "run", progress=None)
 
 
+def test_a_run_that_did_not_record_a_setting_is_not_resumed(tmp_path: Path) -> None:
+    """A run made before a setting was recorded cannot prove it matches: refused, kept intact."""
+    generate(SPEC, SPACE, 1, tmp_path / "run", progress=None)
+    meta_path = tmp_path / "run" / "run.json"
+    meta = json.loads(meta_path.read_text())
+    del meta["constraints"]
+    meta_path.write_text(json.dumps(meta))
+    with pytest.raises(ConfigError, match="does not record 'constraints'"):
+        generate(SPEC, SPACE, 2, tmp_path / "run", progress=None)
+    assert "constraints" not in json.loads(meta_path.read_text())  # nothing rewritten
+    assert len(read_run(tmp_path / "run")) == 1
+
+
 def test_generate_selects_the_constraint_set(tmp_path: Path) -> None:
     """``init generate --constraints`` builds (and records) the NLP with the named set."""
     from roughwalk.cli.main import main

@@ -56,6 +56,21 @@ def test_model_file_holds_arrays_only_and_predicts_the_same_after_reload(tmp_pat
     back.check(nlp)  # the problem it was made for is accepted
 
 
+def test_fingerprint_follows_the_weights_not_the_name(tmp_path: Path) -> None:
+    """A run resumed with a retrained model of the same name must be told apart."""
+    nlp = build_problem(SPEC).formulation
+    layout = problem_signature(nlp)["layout"]
+    model = _model(nlp.n_variables, layout, np.random.default_rng(1))
+    renamed = LearnedModel.load(model.save(tmp_path / "other_name.npz"))
+    assert renamed.fingerprint == model.fingerprint
+    retrained = _model(nlp.n_variables, layout, np.random.default_rng(2))
+    retrained.save(tmp_path / "m.npz")
+    assert LearnedModel.load(tmp_path / "m.npz").fingerprint != model.fingerprint
+    nudged = LearnedModel.load(tmp_path / "m.npz")
+    nudged.mlp.weights[0][0, 0] += np.float32(1e-3)
+    assert nudged.fingerprint != retrained.fingerprint
+
+
 def test_model_file_is_read_once_per_version(tmp_path: Path) -> None:
     nlp = build_problem(SPEC).formulation
     layout = problem_signature(nlp)["layout"]

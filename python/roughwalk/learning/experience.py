@@ -164,7 +164,14 @@ class ExperienceRun:
         if meta_path.is_file():
             old = json.loads(meta_path.read_text())
             for key, value in meta.items():
-                if key in old and old[key] != value:
+                if key not in old:
+                    # An older run that did not record this cannot prove it matches
+                    # (e.g. solved before the constraint set was recorded).
+                    raise ConfigError(
+                        f"{self.folder} holds a run that does not record '{key}' "
+                        f"(asked {value!r}); use another folder"
+                    )
+                if old[key] != value:
                     raise ConfigError(
                         f"{self.folder} holds a run with another '{key}' "
                         f"({old[key]!r}, asked {value!r}); use another folder"
@@ -295,6 +302,8 @@ def generate(
             "split": split,
             "seed": seed,
             "init": init,
+            # The guesses' source by content: a retrained model keeps its name.
+            "model": None if model is None else model.fingerprint,
             "max_iter": max_iter,
         },
     )

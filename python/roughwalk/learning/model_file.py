@@ -11,6 +11,7 @@ initialiser is specific to one environment and one variable layout (Melon
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 from pathlib import Path
@@ -77,6 +78,18 @@ class LearnedModel:
     def name(self) -> str:
         """The model's name (its file's stem when loaded)."""
         return str(self.header.get("name", "model"))
+
+    @property
+    def fingerprint(self) -> str:
+        """SHA-256 of the networks' arrays: the same for the same weights, whatever the name."""
+        digest = hashlib.sha256()
+        nets = [("", self.mlp)] + ([("m_", self.multiplier_mlp)] if self.multiplier_mlp else [])
+        for prefix, net in nets:
+            for key, value in sorted(net.arrays().items()):
+                array = np.ascontiguousarray(value)
+                digest.update(f"{prefix}{key}:{array.dtype.str}:{array.shape}".encode())
+                digest.update(array.tobytes())
+        return digest.hexdigest()
 
     @property
     def problem(self) -> ProblemSpec:
