@@ -373,12 +373,7 @@ impl CertificateSearch<'_> {
             let mut omega = [0.0; 3];
             let mut q = [0.0; 12];
             let mut reachable = true;
-            let mut frames = [LinkFrames {
-                pos: [[0.0; 3]; 3],
-                rot: [[[0.0; 3]; 3]; 3],
-                anchor: [[0.0; 3]; 3],
-                axis: [[0.0; 3]; 3],
-            }; 4];
+            let mut frames = [LinkFrames::default(); 4];
             for (i, leg) in legs.iter().enumerate() {
                 let target = pose.to_body(feet[i]);
                 // Out of the reach shell, the closest reachable foot is about
@@ -387,21 +382,17 @@ impl CertificateSearch<'_> {
                 // only the direction and size of the error).
                 // Inside it, a target the joint limits keep the foot from
                 // gets the clamped analytic solution, for the same reason.
-                let (ik, leg_frames) = match self.reach[i].aim(target) {
-                    Some(aim) => match leg.ik_exact(aim, None) {
-                        Some((near, near_frames)) => {
-                            let near = IkResult {
-                                reachable: false,
-                                ..near
-                            };
-                            (near, near_frames)
-                        }
-                        None => leg.ik_or_clamped(target, None),
+                let ik = match self.reach[i].aim(target) {
+                    Some(aim) => match leg.ik_exact_into(aim, None, &mut frames[i]) {
+                        Some(near) => IkResult {
+                            reachable: false,
+                            ..near
+                        },
+                        None => leg.ik_or_clamped_into(target, None, &mut frames[i]),
                     },
-                    None => leg.ik_or_clamped(target, None),
+                    None => leg.ik_or_clamped_into(target, None, &mut frames[i]),
                 };
                 q[3 * i..3 * i + 3].copy_from_slice(&ik.q);
-                frames[i] = leg_frames;
                 if !ik.reachable {
                     // Zucker 2011, §3.2: a virtual force at the reachable foot toward its target.
                     reachable = false;

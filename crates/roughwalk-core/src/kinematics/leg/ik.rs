@@ -169,10 +169,11 @@ pub(super) fn wrap_into_limits(q: f64, lower: f64, upper: f64) -> Option<f64> {
 }
 
 /// What the analytic IK found: a candidate that reaches the target, or the
-/// nearest one (error [m], q, frames) if it was asked for.
+/// nearest one (error [m], q) if it was asked for; its link frames are
+/// written where the caller asked.
 enum Analytic {
-    Reached(IkResult, LinkFrames),
-    Nearest(Option<(f64, Vec3, LinkFrames)>),
+    Reached(IkResult),
+    Nearest(Option<(f64, Vec3)>),
 }
 
 /// The four solutions (2 HAA × 2 knee branches) of the limit-free chain,
@@ -261,8 +262,9 @@ impl LegChain {
             return (result, self.link_frames(q));
         }
         let solve_target = self.solve_target(target);
-        if let Some(found) = self.ik_exact_at(solve_target, target, knee_sign) {
-            return found;
+        let mut frames = LinkFrames::default();
+        if let Some(found) = self.ik_exact_at(solve_target, target, knee_sign, &mut frames) {
+            return (found, frames);
         }
         let q = self.closest_within_limits(solve_target);
         let frames = self.link_frames(q);
@@ -287,10 +289,26 @@ impl LegChain {
     /// that `ik` falls back to (for callers that only ask whether a point
     /// can be reached).
     pub fn ik_exact(&self, target: Vec3, knee_sign: Option<f64>) -> Option<(IkResult, LinkFrames)> {
+        let mut frames = LinkFrames::default();
+        self.ik_exact_into(target, knee_sign, &mut frames)
+            .map(|r| (r, frames))
+    }
+
+    /// [`Self::ik_exact`] writing the link frames into `frames` (left as
+    /// they were when it returns `None`): the pose certificate keeps every
+    /// leg's frames in one array, and 432-byte frames returned through the
+    /// IK's layers were copied three times on the way (~5 % of a
+    /// certificate's instructions on the logs board).
+    pub fn ik_exact_into(
+        &self,
+        target: Vec3,
+        knee_sign: Option<f64>,
+        frames: &mut LinkFrames,
+    ) -> Option<IkResult> {
         if !target.iter().all(|v| v.is_finite()) {
             return None;
         }
-        self.ik_exact_at(self.solve_target(target), target, knee_sign)
+        self.ik_exact_at(self.solve_target(target), target, knee_sign, frames)
     }
 
     /// The point the analytic IK solves for: `target`, pulled in to
@@ -313,25 +331,39 @@ impl LegChain {
     /// that need only the direction and rough size of the foot's error, such
     /// as the pose certificate's reachability step (Zucker 2011, §3.2).
     pub fn ik_or_clamped(&self, target: Vec3, knee_sign: Option<f64>) -> (IkResult, LinkFrames) {
+        let mut frames = LinkFrames::default();
+        let result = self.ik_or_clamped_into(target, knee_sign, &mut frames);
+        (result, frames)
+    }
+
+    /// [`Self::ik_or_clamped`] writing the link frames into `frames` (see
+    /// [`Self::ik_exact_into`] for why).
+    pub fn ik_or_clamped_into(
+        &self,
+        target: Vec3,
+        knee_sign: Option<f64>,
+        frames: &mut LinkFrames,
+    ) -> IkResult {
         if !target.iter().all(|v| v.is_finite()) {
-            return self.ik_with_frames(target, knee_sign);
+            let (result, f) = self.ik_with_frames(target, knee_sign);
+            *frames = f;
+            return result;
         }
         let solve_target = self.solve_target(target);
-        let (error, q, frames) = match self.analytic(solve_target, target, knee_sign, true) {
-            Analytic::Reached(result, frames) => return (result, frames),
+        let (error, q) = match self.analytic(solve_target, target, knee_sign, true, frames) {
+            Analytic::Reached(result) => return result,
             Analytic::Nearest(nearest) => nearest.expect("four clamped candidates"),
         };
         let (lower, upper) = (self.params.lower, self.params.upper);
         let on_limit =
             (0..3).any(|k| q[k] <= lower[k] + LIMIT_SLACK || q[k] >= upper[k] - LIMIT_SLACK);
         let reachable = error <= IK_TOLERANCE;
-        let result = IkResult {
+        IkResult {
             q,
             reachable,
             within_limits: reachable || !on_limit,
             error,
-        };
-        (result, frames)
+        }
     }
 
     /// The knee branch to prefer, ±1.
@@ -348,9 +380,10 @@ impl LegChain {
         solve_target: Vec3,
         target: Vec3,
         knee_sign: Option<f64>,
-    ) -> Option<(IkResult, LinkFrames)> {
-        match self.analytic(solve_target, target, knee_sign, false) {
-            Analytic::Reached(result, frames) => Some((result, frames)),
+        frames: &mut LinkFrames,
+    ) -> Option<IkResult> {
+        match self.analytic(solve_target, target, knee_sign, false, frames) {
+            Analytic::Reached(result) => Some(result),
             Analytic::Nearest(_) => None,
         }
     }
@@ -365,12 +398,13 @@ impl LegChain {
         target: Vec3,
         knee_sign: Option<f64>,
         nearest: bool,
+        out: &mut LinkFrames,
     ) -> Analytic {
         let (lower, upper) = (self.params.lower, self.params.upper);
         // Candidates are built one at a time: the first usually fits, and
         // each costs a handful of atan2/acos/sin_cos.
         let candidates = AnalyticCandidates::new(self, solve_target, self.knee(knee_sign));
-        let mut best: Option<(f64, Vec3, LinkFrames)> = None;
+        let mut best: Option<(f64, Vec3)> = None;
         for k in 0..4 {
             let q = candidates.get(self, k);
             let wrapped = [0, 1, 2].map(|k| wrap_into_limits(q[k], lower[k], upper[k]));
@@ -383,7 +417,8 @@ impl LegChain {
                         within_limits: true,
                         error,
                     };
-                    return Analytic::Reached(result, frames);
+                    *out = frames;
+                    return Analytic::Reached(result);
                 }
                 (q, error, frames)
             } else if nearest {
@@ -397,8 +432,11 @@ impl LegChain {
                 continue;
             };
             match best {
-                Some((e, _, _)) if e <= error => {}
-                _ if nearest => best = Some((error, q, frames)),
+                Some((e, _)) if e <= error => {}
+                _ if nearest => {
+                    best = Some((error, q));
+                    *out = frames;
+                }
                 _ => {}
             }
         }
