@@ -294,11 +294,11 @@ impl LegChain {
             .map(|r| (r, frames))
     }
 
-    /// [`Self::ik_exact`] writing the link frames into `frames` (left as
-    /// they were when it returns `None`): the pose certificate keeps every
-    /// leg's frames in one array, and 432-byte frames returned through the
-    /// IK's layers were copied three times on the way (~5 % of a
-    /// certificate's instructions on the logs board).
+    /// [`Self::ik_exact`] writing the link frames into `frames` (which hold
+    /// a rejected candidate's when it returns `None`): the pose certificate
+    /// keeps every leg's frames in one array, and 432-byte frames returned
+    /// through the IK's layers were copied three times on the way (~5 % of
+    /// a certificate's instructions on the logs board).
     pub fn ik_exact_into(
         &self,
         target: Vec3,
@@ -391,7 +391,9 @@ impl LegChain {
     /// The first analytic candidate, in order of preference, that reaches
     /// `target` within the joint limits; otherwise, with `nearest`, the
     /// candidate (clamped into the limits where it leaves them) whose foot
-    /// is nearest, as (error [m], q, frames).
+    /// is nearest, as (error [m], q). Each candidate's frames are built in
+    /// `out`, which holds the returned candidate's frames on return (any
+    /// candidate's when none is returned).
     fn analytic(
         &self,
         solve_target: Vec3,
@@ -404,12 +406,14 @@ impl LegChain {
         // Candidates are built one at a time: the first usually fits, and
         // each costs a handful of atan2/acos/sin_cos.
         let candidates = AnalyticCandidates::new(self, solve_target, self.knee(knee_sign));
-        let mut best: Option<(f64, Vec3)> = None;
+        // The nearest candidate so far keeps its frames here (the rare
+        // out-of-reach case); the usual first-candidate hit copies nothing.
+        let mut best: Option<(f64, Vec3, LinkFrames)> = None;
         for k in 0..4 {
             let q = candidates.get(self, k);
             let wrapped = [0, 1, 2].map(|k| wrap_into_limits(q[k], lower[k], upper[k]));
-            let (q, error, frames) = if let [Some(a), Some(b), Some(c)] = wrapped {
-                let (q, error, frames) = self.polish([a, b, c], target);
+            let (q, error) = if let [Some(a), Some(b), Some(c)] = wrapped {
+                let (q, error) = self.polish([a, b, c], target, out);
                 if error <= IK_TOLERANCE {
                     let result = IkResult {
                         q,
@@ -417,30 +421,29 @@ impl LegChain {
                         within_limits: true,
                         error,
                     };
-                    *out = frames;
                     return Analytic::Reached(result);
                 }
-                (q, error, frames)
+                (q, error)
             } else if nearest {
                 let q = [0, 1, 2].map(|j| {
                     wrapped[j].unwrap_or_else(|| wrap_angle(q[j]).clamp(lower[j], upper[j]))
                 });
-                let frames = self.link_frames(q);
-                let foot = add(frames.pos[2], mat_vec(&frames.rot[2], self.params.foot));
-                (q, norm(sub(foot, target)), frames)
+                *out = self.link_frames(q);
+                let foot = add(out.pos[2], mat_vec(&out.rot[2], self.params.foot));
+                (q, norm(sub(foot, target)))
             } else {
                 continue;
             };
             match best {
-                Some((e, _)) if e <= error => {}
-                _ if nearest => {
-                    best = Some((error, q));
-                    *out = frames;
-                }
+                Some((e, _, _)) if e <= error => {}
+                _ if nearest => best = Some((error, q, *out)),
                 _ => {}
             }
         }
-        Analytic::Nearest(best)
+        Analytic::Nearest(best.map(|(error, q, frames)| {
+            *out = frames;
+            (error, q)
+        }))
     }
 
     /// The target relative to the HAA anchor, in the hip frame at q_HAA = 0 [m].
@@ -450,33 +453,33 @@ impl LegChain {
 
     /// A few Newton steps from an analytic solution, to take out the error of
     /// a slightly imperfect axis structure or of acos near a straight knee.
-    /// Returns the angles, the foot error [m] and the link frames at them.
-    fn polish(&self, q: Vec3, target: Vec3) -> (Vec3, f64, LinkFrames) {
+    /// Returns the angles and the foot error [m], with the link frames at
+    /// them in `frames`.
+    fn polish(&self, q: Vec3, target: Vec3, frames: &mut LinkFrames) -> (Vec3, f64) {
         let (lower, upper) = (self.params.lower, self.params.upper);
-        let fk = |q: Vec3| {
-            let f = self.link_frames(q);
-            let foot = add(f.pos[2], mat_vec(&f.rot[2], self.params.foot));
-            (foot, f)
-        };
-        let (mut q, (mut foot, mut frames)) = (q, fk(q));
+        let foot_of = |f: &LinkFrames| add(f.pos[2], mat_vec(&f.rot[2], self.params.foot));
+        *frames = self.link_frames(q);
+        let (mut q, mut foot) = (q, foot_of(frames));
         let mut error = norm(sub(foot, target));
         for _ in 0..4 {
             if error <= 1e-14 || error > NEWTON_RANGE {
                 break;
             }
-            let jacobian = Self::columns(&frames, foot, 2);
+            let jacobian = Self::columns(frames, foot, 2);
             let Some(dq) = solve(&jacobian, sub(target, foot)) else {
                 break;
             };
             let q_new = clamp_to(add(q, dq), lower, upper);
-            let (foot_new, frames_new) = fk(q_new);
+            let frames_new = self.link_frames(q_new);
+            let foot_new = foot_of(&frames_new);
             let e_new = norm(sub(foot_new, target));
             if !e_new.is_finite() || e_new >= error {
                 break;
             }
-            (q, foot, frames, error) = (q_new, foot_new, frames_new, e_new);
+            (q, foot, error) = (q_new, foot_new, e_new);
+            *frames = frames_new;
         }
-        (q, error, frames)
+        (q, error)
     }
 }
 
