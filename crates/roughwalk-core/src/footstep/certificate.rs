@@ -26,6 +26,16 @@ use crate::kinematics::quadruped::{BodyPose, Quadruped};
 use crate::kinematics::support::support_triangle_incircle;
 use crate::sdf::SignedDistanceField;
 
+/// How much closer than the clearance check reports [m], per metre of the
+/// distance field's resolution, any point of the body may be when the
+/// field is sampled finer (see [`CollisionModel::closest_below`]): √3/2,
+/// the trilinear interpolation error bound of the field (half a cell
+/// diagonal, the `sdf_error` the certified clearance already adds), so a
+/// certified pose is never rejected by a finer sampling by more than the
+/// field's own error. The old fixed 1-voxel spacing allowed L·h/2 with
+/// L ≈ 1.4–1.7, the same order.
+pub const CLEARANCE_TOLERANCE: f64 = 0.866_025_403_784_438_6;
+
 /// A point in the x–y plane [m].
 pub type Vec2 = [f64; 2];
 
@@ -362,7 +372,7 @@ impl CertificateSearch<'_> {
         let tri = support.map(|leg| [contacts[leg][0], contacts[leg][1]]);
         let required = cfg.clearance + self.sdf_error;
         let cutoff = required.max(cfg.preferred_clearance + self.sdf_error);
-        let spacing = self.sdf.grid().spec().resolution;
+        let tolerance = CLEARANCE_TOLERANCE * self.sdf.grid().spec().resolution;
         let mut pose = self.initial_pose(feet, contacts, support, heading);
         let start = pose.x;
         let mut failure = CertificateFailure::Unreachable;
@@ -373,12 +383,7 @@ impl CertificateSearch<'_> {
             let mut omega = [0.0; 3];
             let mut q = [0.0; 12];
             let mut reachable = true;
-            let mut frames = [LinkFrames {
-                pos: [[0.0; 3]; 3],
-                rot: [[[0.0; 3]; 3]; 3],
-                anchor: [[0.0; 3]; 3],
-                axis: [[0.0; 3]; 3],
-            }; 4];
+            let mut frames = [LinkFrames::default(); 4];
             for (i, leg) in legs.iter().enumerate() {
                 let target = pose.to_body(feet[i]);
                 // Out of the reach shell, the closest reachable foot is about
@@ -387,21 +392,17 @@ impl CertificateSearch<'_> {
                 // only the direction and size of the error).
                 // Inside it, a target the joint limits keep the foot from
                 // gets the clamped analytic solution, for the same reason.
-                let (ik, leg_frames) = match self.reach[i].aim(target) {
-                    Some(aim) => match leg.ik_exact(aim, None) {
-                        Some((near, near_frames)) => {
-                            let near = IkResult {
-                                reachable: false,
-                                ..near
-                            };
-                            (near, near_frames)
-                        }
-                        None => leg.ik_or_clamped(target, None),
+                let ik = match self.reach[i].aim(target) {
+                    Some(aim) => match leg.ik_exact_into(aim, None, &mut frames[i]) {
+                        Some(near) => IkResult {
+                            reachable: false,
+                            ..near
+                        },
+                        None => leg.ik_or_clamped_into(target, None, &mut frames[i]),
                     },
-                    None => leg.ik_or_clamped(target, None),
+                    None => leg.ik_or_clamped_into(target, None, &mut frames[i]),
                 };
                 q[3 * i..3 * i + 3].copy_from_slice(&ik.q);
-                frames[i] = leg_frames;
                 if !ik.reachable {
                     // Zucker 2011, §3.2: a virtual force at the reachable foot toward its target.
                     reachable = false;
@@ -449,7 +450,7 @@ impl CertificateSearch<'_> {
             }
             let closest = self
                 .collision
-                .closest_below(self.sdf, &pose, &frames, cutoff, spacing);
+                .closest_below(self.sdf, &pose, &frames, cutoff, tolerance);
             let collision = closest.filter(|c| c.distance < required);
             if let Some(c) = collision {
                 violation += required - c.distance;

@@ -9,12 +9,6 @@ use crate::kinematics::math::{add, mat_vec, norm, scale, sub, Vec3};
 use crate::kinematics::quadruped::BodyPose;
 use crate::sdf::SignedDistanceField;
 
-/// Bound on the gradient norm of a trilinear interpolant of a distance
-/// field: each component is an average of finite differences along one
-/// axis, each at most 1, so |∇d| ≤ √3. Used to skip samples that cannot be
-/// closer than the cut-off.
-const LIPSCHITZ: f64 = 1.732_050_808_568_877_3;
-
 /// The field's value [m] at `p` without its gradient (the trilinear value of
 /// the lattice cell, or the exact fall-back outside the lattice): capsule
 /// marching needs only values, and the gradient only at the minimum.
@@ -27,6 +21,38 @@ fn distance(sdf: &SignedDistanceField, p: Vec3) -> f64 {
         Some(v) => v,
         None => sdf.distance_and_gradient(p).0,
     }
+}
+
+/// The part [t0, t1] (arc lengths [m] from `a` along the unit direction
+/// `u`) of a segment of length `length` that lies in the closed box
+/// [lo, hi], or None if it misses it (slab clipping).
+fn clip_to_box(a: Vec3, u: Vec3, length: f64, lo: Vec3, hi: Vec3) -> Option<(f64, f64)> {
+    let (mut t0, mut t1) = (0.0f64, length);
+    for k in 0..3 {
+        if u[k] == 0.0 {
+            if a[k] < lo[k] || a[k] > hi[k] {
+                return None;
+            }
+        } else {
+            let (ta, tb) = ((lo[k] - a[k]) / u[k], (hi[k] - a[k]) / u[k]);
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+        }
+    }
+    (t0 <= t1).then_some((t0, t1))
+}
+
+/// A stretch of a capsule's axis on which the field is one Lipschitz
+/// function: the lattice's interpolant, or the exact fall-back beyond it.
+#[derive(Clone, Copy)]
+struct Piece {
+    /// Arc lengths [m] along the axis.
+    t0: f64,
+    t1: f64,
+    /// Bound on |d(field)/dt| on it [m/m].
+    lipschitz: f64,
+    /// Whether the lattice's interpolant applies (else the exact distance).
+    lattice: bool,
 }
 
 /// A capsule fixed to the trunk or to a leg link (a sphere when a = b).
@@ -110,48 +136,117 @@ impl CollisionModel {
     }
 
     /// The least clearance of any capsule, if it is below `cutoff` [m]
-    /// (`None` means every capsule is at least `cutoff` from the terrain).
+    /// (`None` means every capsule is at least `cutoff` − `tolerance` from
+    /// the terrain), up to `tolerance` [m] (> 0).
     ///
-    /// Each capsule's axis is sampled at spacing `spacing` [m] where it is
-    /// near the cut-off, and skipped ahead where the field proves it cannot
-    /// be (a sample at clearance v rules out anything within
-    /// (v − cutoff)/√3 of it), so a robot far from the terrain costs one
-    /// query per capsule.
+    /// The contract, against a sampling of the same field as fine as one
+    /// likes: `None` means no point of any capsule's axis is closer than
+    /// `cutoff − tolerance`; `Some(c)` means `c.distance` is attained at
+    /// `c.world` and no point is closer than `c.distance − tolerance`.
+    ///
+    /// Each capsule's axis is sphere-traced with the field's Lipschitz
+    /// bound L along it: the lattice's measured axis slopes
+    /// ([`crate::sdf::DistanceGrid::directional_lipschitz`]) inside the
+    /// node box, 1 beyond it (the exact distance), the two marched
+    /// separately because the field jumps where they meet. Between samples
+    /// at values v₁, v₂ a distance s apart the field is at least
+    /// (v₁ + v₂ − L·s)/2, so from a sample at v, with the least value so
+    /// far `bound`, the next may be (v − bound + 2·tolerance)/L ahead; and
+    /// a capsule (or piece) whose centre is at v ≥ bound − tolerance +
+    /// L·half-length needs no other sample. A robot far from the terrain
+    /// costs one query per capsule.
     pub fn closest_below(
         &self,
         sdf: &SignedDistanceField,
         pose: &BodyPose,
         frames: &[LinkFrames; 4],
         cutoff: f64,
-        spacing: f64,
+        tolerance: f64,
     ) -> Option<Clearance> {
-        // (distance, capsule, fraction along it, world point)
-        let mut best: Option<(f64, usize, f64, Vec3)> = None;
+        let grid = sdf.grid();
+        let (lo, hi) = (grid.spec().origin, grid.spec().upper());
+        // A floor keeps the march finite for a tolerance of 0 [m].
+        let gap = 2.0 * tolerance.max(1e-9);
+        // (distance, capsule, fraction along it, world point, on the lattice)
+        let mut best: Option<(f64, usize, f64, Vec3, bool)> = None;
         let mut bound = cutoff;
         for (k, c) in self.capsules.iter().enumerate() {
             let (wa, wb) = self.world_segment(k, pose, frames);
             let ab = sub(wb, wa);
             let length = norm(ab);
-            let d_mid = distance(sdf, add(wa, scale(ab, 0.5)));
-            if d_mid - c.radius - LIPSCHITZ * 0.5 * length >= bound {
-                continue;
+            let (u, per_length) = if length > 0.0 {
+                (scale(ab, 1.0 / length), 1.0 / length)
+            } else {
+                ([0.0; 3], 0.0)
+            };
+            let on_lattice = |t0: f64, t1: f64| Piece {
+                t0,
+                t1,
+                lipschitz: grid.directional_lipschitz(u),
+                lattice: true,
+            };
+            let exact = |t0: f64, t1: f64| Piece {
+                t0,
+                t1,
+                lipschitz: 1.0,
+                lattice: false,
+            };
+            let mut pieces = [None; 3];
+            if grid.spec().contains(wa) && grid.spec().contains(wb) {
+                pieces[0] = Some(on_lattice(0.0, length));
+            } else {
+                match clip_to_box(wa, u, length, lo, hi) {
+                    None => pieces[0] = Some(exact(0.0, length)),
+                    Some((t0, t1)) => {
+                        pieces[0] = (t0 > 0.0).then(|| exact(0.0, t0));
+                        pieces[1] = Some(on_lattice(t0, t1));
+                        pieces[2] = (t1 < length).then(|| exact(t1, length));
+                    }
+                }
             }
-            let mut t = 0.0;
-            loop {
-                let f = if length > 0.0 { t / length } else { 0.0 };
-                let p = add(wa, scale(ab, f));
-                let v = distance(sdf, p) - c.radius;
-                if v < bound {
-                    bound = v;
-                    best = Some((v, k, f, p));
+            for piece in pieces.into_iter().flatten() {
+                let at = |t: f64| add(wa, scale(u, t));
+                // Beyond the box the exact distance, even on the box's face
+                // (where `distance` would interpolate).
+                let field = |p: Vec3| {
+                    if piece.lattice {
+                        distance(sdf, p)
+                    } else {
+                        sdf.surface().signed_distance(p).0
+                    }
+                };
+                let l = piece.lipschitz;
+                let half = 0.5 * (piece.t1 - piece.t0);
+                let mid = field(at(piece.t0 + half)) - c.radius;
+                if mid - l * half >= bound - tolerance {
+                    if mid < bound {
+                        bound = mid;
+                        best = Some((
+                            mid,
+                            k,
+                            (piece.t0 + half) * per_length,
+                            at(piece.t0 + half),
+                            piece.lattice,
+                        ));
+                    }
+                    continue;
                 }
-                if t >= length {
-                    break;
+                let mut t = piece.t0;
+                loop {
+                    let p = at(t);
+                    let v = field(p) - c.radius;
+                    if v < bound {
+                        bound = v;
+                        best = Some((v, k, t * per_length, p, piece.lattice));
+                    }
+                    if t >= piece.t1 {
+                        break;
+                    }
+                    t = (t + (v - bound + gap) / l).min(piece.t1);
                 }
-                t = (t + spacing.max((v - bound) / LIPSCHITZ)).min(length);
             }
         }
-        best.map(|(v, k, f, p)| {
+        best.map(|(v, k, f, p, lattice)| {
             let c = &self.capsules[k];
             let local = add(c.a, scale(sub(c.b, c.a), f));
             Clearance {
@@ -165,7 +260,11 @@ impl CollisionModel {
                     },
                 },
                 world: p,
-                gradient: sdf.distance_and_gradient(p).1,
+                gradient: if lattice {
+                    sdf.distance_and_gradient(p).1
+                } else {
+                    sdf.surface().signed_distance(p).1
+                },
                 capsule: k,
             }
         })
@@ -203,6 +302,98 @@ pub(crate) mod tests {
             }
         }
         best
+    }
+
+    /// Rounded rocks on [0, 0.6]² m: a far field that is not 1-Lipschitz.
+    fn rocky_field() -> &'static (HeightField, SignedDistanceField) {
+        static FIELD: std::sync::OnceLock<(HeightField, SignedDistanceField)> =
+            std::sync::OnceLock::new();
+        FIELD.get_or_init(|| {
+            let (height, _) = crate::testing::rocky_board(30, 0.08, 7);
+            // The board's rocks start 0.4 m in; shift them onto the lattice.
+            crate::testing::terrain(0.6, move |x, y| height(x + 0.4, y), 0.05, 0.15)
+        })
+    }
+
+    /// A point over the terrain at `u[2]`·6 cm − 1 cm above its surface,
+    /// over and beyond the lattice (x ∈ [0, 0.6], y ∈ [−0.3, 0.3]).
+    fn point_in(hf: &HeightField, u: [f64; 3]) -> Vec3 {
+        let (x, y) = (-0.05 + 0.7 * u[0], -0.35 + 0.7 * u[1]);
+        let (ix, iy) = (
+            (x.clamp(0.0, 0.6) / 0.005) as isize,
+            ((y.clamp(-0.3, 0.3) + 0.3) / 0.005) as isize,
+        );
+        let ground = hf.at(ix, iy);
+        [x, y, ground - 0.01 + 0.06 * u[2]]
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(400))]
+        /// The march's contract against dense sampling of the same field
+        /// (every 0.05 mm, itself within L·0.025 mm of the true minimum).
+        #[test]
+        fn footstep_capsule_march_is_within_its_tolerance_of_dense_sampling(
+            ends in proptest::collection::vec(proptest::array::uniform3(0.0..1.0f64), 6),
+            radii in proptest::array::uniform3(0.0..0.04f64),
+            short in proptest::array::uniform3(0.0..1.0f64),
+            cutoff in -0.01..0.03f64,
+            tolerance in 0.0003..0.005f64,
+        ) {
+            let (hf, sdf) = rocky_field();
+            let capsules = (0..3)
+                .map(|k| {
+                    let a = point_in(hf, ends[2 * k]);
+                    // Some short capsules, some spheres, some long ones.
+                    let b = add(a, scale(sub(point_in(hf, ends[2 * k + 1]), a), short[k] * short[k]));
+                    Capsule { leg: None, link: 0, a, b, radius: radii[k] }
+                })
+                .collect();
+            let model = CollisionModel::new(capsules).unwrap();
+            let pose = BodyPose { x: [0.0; 3], r: crate::kinematics::math::IDENTITY };
+            let frames = [LinkFrames {
+                pos: [[0.0; 3]; 3],
+                rot: [[[0.0; 3]; 3]; 3],
+                anchor: [[0.0; 3]; 3],
+                axis: [[0.0; 3]; 3],
+            }; 4];
+            let mut dense = f64::INFINITY;
+            for (k, c) in model.capsules().iter().enumerate() {
+                let (a, b) = model.world_segment(k, &pose, &frames);
+                let n = (norm(sub(b, a)) / 0.000_05).ceil() as usize + 1;
+                for s in 0..=n {
+                    let p = add(a, scale(sub(b, a), s as f64 / n as f64));
+                    dense = dense.min(distance(sdf, p) - c.radius);
+                }
+            }
+            let slack = 2.0 * 0.000_025 + 1e-12;
+            match model.closest_below(sdf, &pose, &frames, cutoff, tolerance) {
+                None => proptest::prop_assert!(
+                    dense >= cutoff - tolerance - slack,
+                    "missed {} below the cut-off {}", dense, cutoff
+                ),
+                Some(c) => {
+                    proptest::prop_assert!(c.distance < cutoff);
+                    proptest::prop_assert!(
+                        dense >= c.distance - tolerance - slack,
+                        "reported {} but dense sampling finds {}", c.distance, dense
+                    );
+                    proptest::prop_assert!(c.distance >= dense - slack);
+                    let r = model.capsules()[c.capsule].radius;
+                    // The field there: the lattice's, or on the lattice's face
+                    // the exact one of the stretch beyond (the limit of its values).
+                    let lattice = distance(sdf, c.world) - r - c.distance;
+                    let exact = sdf.surface().signed_distance(c.world).0 - r - c.distance;
+                    proptest::prop_assert!(lattice.abs() < 1e-12 || exact.abs() < 1e-12);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn footstep_rocky_field_is_not_1_lipschitz() {
+        // What makes the measured slopes matter in the test above.
+        let s = rocky_field().1.grid().axis_slopes();
+        assert!(s.iter().any(|&v| v > 1.0 + 1e-3), "{s:?}");
     }
 
     #[test]

@@ -167,6 +167,12 @@ impl FootstepModel {
         config: FootstepConfig,
     ) -> CoreResult<Self> {
         config.validate()?;
+        // The certificates' clearance march steps by the field's slope
+        // bound; a band-seeded far field overestimates with slopes up to
+        // 1.4 (LittleDog boards), its unit-slope envelope lowers those
+        // values only, so clearances on it are never larger and the march
+        // takes fewer samples (AD: 24 % fewer clearance instructions).
+        let sdf = sdf.lipschitz_envelope();
         let map = CostMap::new(heightfield, cost_front, cost_hind, config.resolution)?;
         if map.foothold_count() == 0 {
             return Err(CoreError::Planning(

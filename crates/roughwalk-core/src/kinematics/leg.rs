@@ -51,8 +51,9 @@ pub struct LegParams {
     pub knee_sign: f64,
 }
 
-/// The pose of every joint body of a leg, in the base frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The pose of every joint body of a leg, in the base frame (all zeros by
+/// default: a buffer for the `*_into` IK calls to fill).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LinkFrames {
     /// Origin of body k [m].
     pub pos: [Vec3; 3],

@@ -120,6 +120,34 @@ pub struct DistanceGrid {
     last_cell: [u32; 3],
     /// Linear-index strides of x and y (z is 1).
     stride: [usize; 2],
+    /// Largest |difference| of neighbouring node values along x, y and z,
+    /// over the resolution: see [`Self::axis_slopes`].
+    axis_slopes: [f64; 3],
+}
+
+/// Largest |v(n + e_a) − v(n)| / `resolution` over the nodes, per axis a.
+fn max_axis_slopes(values: &[f32], shape: [usize; 3], resolution: f64) -> [f64; 3] {
+    let [nx, ny, nz] = shape;
+    let mut worst = [0.0f64; 3];
+    for i in 0..nx {
+        for j in 0..ny {
+            let at = (i * ny + j) * nz;
+            let column = &values[at..at + nz];
+            for (k, &v) in column.iter().enumerate() {
+                let v = f64::from(v);
+                if k + 1 < nz {
+                    worst[2] = worst[2].max((f64::from(column[k + 1]) - v).abs());
+                }
+                if j + 1 < ny {
+                    worst[1] = worst[1].max((f64::from(values[at + nz + k]) - v).abs());
+                }
+                if i + 1 < nx {
+                    worst[0] = worst[0].max((f64::from(values[at + ny * nz + k]) - v).abs());
+                }
+            }
+        }
+    }
+    worst.map(|w| w / resolution)
 }
 
 impl DistanceGrid {
@@ -141,10 +169,12 @@ impl DistanceGrid {
             )));
         }
         let [nx, ny, nz] = spec.shape;
+        let axis_slopes = max_axis_slopes(&values, spec.shape, spec.resolution);
         // GridSpec::new keeps every count below u32::MAX, so these fit.
         Ok(Self {
             spec,
             values,
+            axis_slopes,
             inv_resolution: 1.0 / spec.resolution,
             top: [nx, ny, nz].map(|n| (n - 1) as f64),
             last_cell: [nx, ny, nz].map(|n| (n - 2) as u32),
@@ -155,6 +185,74 @@ impl DistanceGrid {
     /// The lattice.
     pub fn spec(&self) -> &GridSpec {
         &self.spec
+    }
+
+    /// Largest |difference| of neighbouring node values along x, y and z,
+    /// divided by the resolution (S_x, S_y, S_z) [m/m].
+    ///
+    /// They bound the trilinear interpolant's partial derivatives: ∂d/∂x at
+    /// any point of a cell is a convex combination of the cell's four
+    /// x-edge differences over the resolution, and likewise for y and z. So
+    /// along a unit direction u, |∇d·u| ≤ S_x|u_x| + S_y|u_y| + S_z|u_z|
+    /// everywhere in the node box. Measured from the stored values, not
+    /// assumed: the far field of a distance transform that starts from a
+    /// band is not exactly 1-Lipschitz (up to 1.4 on the LittleDog boards,
+    /// 2 cm and more off the surface), so √3 — the bound for node values
+    /// of a true distance — would not be one.
+    pub fn axis_slopes(&self) -> [f64; 3] {
+        self.axis_slopes
+    }
+
+    /// The greatest field at or below this one whose neighbouring nodes
+    /// differ by at most one resolution: d'(n) = min over nodes m of
+    /// d(m) + h·|n − m|₁ (a forward and a backward sweep along each axis,
+    /// the L1 distance being separable), so its axis slopes are 1.
+    ///
+    /// Only lowers values, and only where neighbours differ by more than
+    /// a true distance can (the far field of a band-seeded transform, which
+    /// overestimates): a clearance measured on it is never larger. Sphere
+    /// tracing on it may step by ‖u‖₁ instead of up to 1.4·‖u‖₁.
+    #[must_use]
+    pub fn lipschitz_envelope(mut self) -> Self {
+        let [nx, ny, nz] = self.spec.shape;
+        let h = self.spec.resolution as f32;
+        let v = &mut self.values;
+        // Along z (stride 1), then y (stride nz), then x (stride ny·nz).
+        for (stride, count, lines) in [(1, nz, nx * ny), (nz, ny, nx), (ny * nz, nx, 1)] {
+            let inner = if stride == 1 { 1 } else { stride };
+            for line in 0..lines {
+                let block = if stride == 1 {
+                    line * nz
+                } else {
+                    line * count * stride
+                };
+                for offset in 0..inner {
+                    let first = block + offset;
+                    for k in 1..count {
+                        let (prev, at) = (first + (k - 1) * stride, first + k * stride);
+                        v[at] = v[at].min(v[prev] + h);
+                    }
+                    for k in (0..count - 1).rev() {
+                        let (next, at) = (first + (k + 1) * stride, first + k * stride);
+                        v[at] = v[at].min(v[next] + h);
+                    }
+                }
+            }
+        }
+        self.axis_slopes = max_axis_slopes(&self.values, self.spec.shape, self.spec.resolution);
+        self
+    }
+
+    /// The bound of [`Self::axis_slopes`] on |∇d·u| along the direction
+    /// `u` (any length; the bound is for unit speed along it) [m/m].
+    #[inline]
+    pub fn directional_lipschitz(&self, u: [f64; 3]) -> f64 {
+        let n = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+        if n == 0.0 {
+            return 0.0;
+        }
+        let s = self.axis_slopes;
+        (s[0] * u[0].abs() + s[1] * u[1].abs() + s[2] * u[2].abs()) / n
     }
 
     /// Node values [m], z fastest.
@@ -309,6 +407,90 @@ mod tests {
                 lo[a] -= e;
                 let fd = (g.trilinear(hi).unwrap().0 - g.trilinear(lo).unwrap().0) / (2.0 * e);
                 assert!((fd - grad[a]).abs() < 1e-6, "axis {a}: {fd} vs {}", grad[a]);
+            }
+        }
+    }
+
+    #[test]
+    fn axis_slopes_bound_the_interpolant_along_every_direction() {
+        // Random values: far from Lipschitz, so the bound is doing the work.
+        let spec = GridSpec::new([0.0; 3], 0.01, [6, 5, 4]).unwrap();
+        let values: Vec<f32> = (0..spec.len())
+            .map(|i| ((i * 7919) % 23) as f32 * 0.002 + (i % 4) as f32 * 0.004)
+            .collect();
+        let g = DistanceGrid::new(spec, values.clone()).unwrap();
+        let s = g.axis_slopes();
+        // The slopes are attained: each is some edge's difference.
+        let mut brute = [0.0f64; 3];
+        for i in 0..6 {
+            for j in 0..5 {
+                for k in 0..4 {
+                    let v = |i, j, k| f64::from(values[spec.index(i, j, k)]);
+                    let here = v(i, j, k);
+                    for (a, n) in [(0, (i + 1, j, k)), (1, (i, j + 1, k)), (2, (i, j, k + 1))] {
+                        if n.0 < 6 && n.1 < 5 && n.2 < 4 {
+                            brute[a] = brute[a].max((v(n.0, n.1, n.2) - here).abs() / 0.01);
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            (0..3).all(|a| (s[a] - brute[a]).abs() <= 1e-12 * brute[a]),
+            "{s:?} vs {brute:?}"
+        );
+        let (mut worst, e) = (0.0f64, 1e-7);
+        for k in 0..4000usize {
+            let f = k as f64;
+            let p =
+                [0.618_033_9, 0.414_213_5, 0.732_050_8].map(|m| 0.001 + (f * m).fract() * 0.028);
+            let u = [0.302_775_6, 0.236_067_9, 0.645_751_3].map(|m| (f * m).fract() * 2.0 - 1.0);
+            let n = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+            let q = [0, 1, 2].map(|a| p[a] + e * u[a] / n);
+            let slope = (g.value(q).unwrap() - g.value(p).unwrap()).abs() / e;
+            worst = worst.max(slope / g.directional_lipschitz(u));
+        }
+        assert!(worst <= 1.0 + 1e-6, "{worst}");
+        assert!(
+            worst > 0.5,
+            "the bound should be near tight somewhere: {worst}"
+        );
+    }
+
+    #[test]
+    fn lipschitz_envelope_is_the_greatest_unit_slope_field_below() {
+        let spec = GridSpec::new([0.0; 3], 0.01, [5, 4, 6]).unwrap();
+        let values: Vec<f32> = (0..spec.len())
+            .map(|i| ((i * 7919) % 23) as f32 * 0.004)
+            .collect();
+        let g = DistanceGrid::new(spec, values.clone()).unwrap();
+        assert!(g.axis_slopes().iter().all(|&s| s > 1.5));
+        let e = g.lipschitz_envelope();
+        assert!(
+            e.axis_slopes().iter().all(|&s| s <= 1.0 + 1e-5),
+            "{:?}",
+            e.axis_slopes()
+        );
+        // Brute force: min over every node m of d(m) + h·|n − m|₁.
+        for i in 0..5usize {
+            for j in 0..4usize {
+                for k in 0..6usize {
+                    let mut best = f64::INFINITY;
+                    for a in 0..5usize {
+                        for b in 0..4usize {
+                            for c in 0..6usize {
+                                let l1 = i.abs_diff(a) + j.abs_diff(b) + k.abs_diff(c);
+                                best = best
+                                    .min(f64::from(values[spec.index(a, b, c)]) + 0.01 * l1 as f64);
+                            }
+                        }
+                    }
+                    let got = f64::from(e.values()[spec.index(i, j, k)]);
+                    assert!(
+                        (got - best).abs() < 1e-6,
+                        "({i}, {j}, {k}): {got} vs {best}"
+                    );
+                }
             }
         }
     }

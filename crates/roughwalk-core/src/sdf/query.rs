@@ -84,6 +84,16 @@ impl SignedDistanceField {
         Self { grid, surface }
     }
 
+    /// The same field with its lattice values lowered to their unit-slope
+    /// envelope (see [`DistanceGrid::lipschitz_envelope`]).
+    #[must_use]
+    pub fn lipschitz_envelope(self) -> Self {
+        Self {
+            grid: self.grid.lipschitz_envelope(),
+            surface: self.surface,
+        }
+    }
+
     /// The lattice values.
     pub fn grid(&self) -> &DistanceGrid {
         &self.grid

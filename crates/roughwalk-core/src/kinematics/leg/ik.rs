@@ -169,10 +169,11 @@ pub(super) fn wrap_into_limits(q: f64, lower: f64, upper: f64) -> Option<f64> {
 }
 
 /// What the analytic IK found: a candidate that reaches the target, or the
-/// nearest one (error [m], q, frames) if it was asked for.
+/// nearest one (error [m], q) if it was asked for; its link frames are
+/// written where the caller asked.
 enum Analytic {
-    Reached(IkResult, LinkFrames),
-    Nearest(Option<(f64, Vec3, LinkFrames)>),
+    Reached(IkResult),
+    Nearest(Option<(f64, Vec3)>),
 }
 
 /// The four solutions (2 HAA × 2 knee branches) of the limit-free chain,
@@ -261,8 +262,9 @@ impl LegChain {
             return (result, self.link_frames(q));
         }
         let solve_target = self.solve_target(target);
-        if let Some(found) = self.ik_exact_at(solve_target, target, knee_sign) {
-            return found;
+        let mut frames = LinkFrames::default();
+        if let Some(found) = self.ik_exact_at(solve_target, target, knee_sign, &mut frames) {
+            return (found, frames);
         }
         let q = self.closest_within_limits(solve_target);
         let frames = self.link_frames(q);
@@ -287,10 +289,26 @@ impl LegChain {
     /// that `ik` falls back to (for callers that only ask whether a point
     /// can be reached).
     pub fn ik_exact(&self, target: Vec3, knee_sign: Option<f64>) -> Option<(IkResult, LinkFrames)> {
+        let mut frames = LinkFrames::default();
+        self.ik_exact_into(target, knee_sign, &mut frames)
+            .map(|r| (r, frames))
+    }
+
+    /// [`Self::ik_exact`] writing the link frames into `frames` (which hold
+    /// a rejected candidate's when it returns `None`): the pose certificate
+    /// keeps every leg's frames in one array, and 432-byte frames returned
+    /// through the IK's layers were copied three times on the way (~5 % of
+    /// a certificate's instructions on the logs board).
+    pub fn ik_exact_into(
+        &self,
+        target: Vec3,
+        knee_sign: Option<f64>,
+        frames: &mut LinkFrames,
+    ) -> Option<IkResult> {
         if !target.iter().all(|v| v.is_finite()) {
             return None;
         }
-        self.ik_exact_at(self.solve_target(target), target, knee_sign)
+        self.ik_exact_at(self.solve_target(target), target, knee_sign, frames)
     }
 
     /// The point the analytic IK solves for: `target`, pulled in to
@@ -313,25 +331,39 @@ impl LegChain {
     /// that need only the direction and rough size of the foot's error, such
     /// as the pose certificate's reachability step (Zucker 2011, §3.2).
     pub fn ik_or_clamped(&self, target: Vec3, knee_sign: Option<f64>) -> (IkResult, LinkFrames) {
+        let mut frames = LinkFrames::default();
+        let result = self.ik_or_clamped_into(target, knee_sign, &mut frames);
+        (result, frames)
+    }
+
+    /// [`Self::ik_or_clamped`] writing the link frames into `frames` (see
+    /// [`Self::ik_exact_into`] for why).
+    pub fn ik_or_clamped_into(
+        &self,
+        target: Vec3,
+        knee_sign: Option<f64>,
+        frames: &mut LinkFrames,
+    ) -> IkResult {
         if !target.iter().all(|v| v.is_finite()) {
-            return self.ik_with_frames(target, knee_sign);
+            let (result, f) = self.ik_with_frames(target, knee_sign);
+            *frames = f;
+            return result;
         }
         let solve_target = self.solve_target(target);
-        let (error, q, frames) = match self.analytic(solve_target, target, knee_sign, true) {
-            Analytic::Reached(result, frames) => return (result, frames),
+        let (error, q) = match self.analytic(solve_target, target, knee_sign, true, frames) {
+            Analytic::Reached(result) => return result,
             Analytic::Nearest(nearest) => nearest.expect("four clamped candidates"),
         };
         let (lower, upper) = (self.params.lower, self.params.upper);
         let on_limit =
             (0..3).any(|k| q[k] <= lower[k] + LIMIT_SLACK || q[k] >= upper[k] - LIMIT_SLACK);
         let reachable = error <= IK_TOLERANCE;
-        let result = IkResult {
+        IkResult {
             q,
             reachable,
             within_limits: reachable || !on_limit,
             error,
-        };
-        (result, frames)
+        }
     }
 
     /// The knee branch to prefer, ±1.
@@ -348,9 +380,10 @@ impl LegChain {
         solve_target: Vec3,
         target: Vec3,
         knee_sign: Option<f64>,
-    ) -> Option<(IkResult, LinkFrames)> {
-        match self.analytic(solve_target, target, knee_sign, false) {
-            Analytic::Reached(result, frames) => Some((result, frames)),
+        frames: &mut LinkFrames,
+    ) -> Option<IkResult> {
+        match self.analytic(solve_target, target, knee_sign, false, frames) {
+            Analytic::Reached(result) => Some(result),
             Analytic::Nearest(_) => None,
         }
     }
@@ -358,24 +391,29 @@ impl LegChain {
     /// The first analytic candidate, in order of preference, that reaches
     /// `target` within the joint limits; otherwise, with `nearest`, the
     /// candidate (clamped into the limits where it leaves them) whose foot
-    /// is nearest, as (error [m], q, frames).
+    /// is nearest, as (error [m], q). Each candidate's frames are built in
+    /// `out`, which holds the returned candidate's frames on return (any
+    /// candidate's when none is returned).
     fn analytic(
         &self,
         solve_target: Vec3,
         target: Vec3,
         knee_sign: Option<f64>,
         nearest: bool,
+        out: &mut LinkFrames,
     ) -> Analytic {
         let (lower, upper) = (self.params.lower, self.params.upper);
         // Candidates are built one at a time: the first usually fits, and
         // each costs a handful of atan2/acos/sin_cos.
         let candidates = AnalyticCandidates::new(self, solve_target, self.knee(knee_sign));
+        // The nearest candidate so far keeps its frames here (the rare
+        // out-of-reach case); the usual first-candidate hit copies nothing.
         let mut best: Option<(f64, Vec3, LinkFrames)> = None;
         for k in 0..4 {
             let q = candidates.get(self, k);
             let wrapped = [0, 1, 2].map(|k| wrap_into_limits(q[k], lower[k], upper[k]));
-            let (q, error, frames) = if let [Some(a), Some(b), Some(c)] = wrapped {
-                let (q, error, frames) = self.polish([a, b, c], target);
+            let (q, error) = if let [Some(a), Some(b), Some(c)] = wrapped {
+                let (q, error) = self.polish([a, b, c], target, out);
                 if error <= IK_TOLERANCE {
                     let result = IkResult {
                         q,
@@ -383,26 +421,29 @@ impl LegChain {
                         within_limits: true,
                         error,
                     };
-                    return Analytic::Reached(result, frames);
+                    return Analytic::Reached(result);
                 }
-                (q, error, frames)
+                (q, error)
             } else if nearest {
                 let q = [0, 1, 2].map(|j| {
                     wrapped[j].unwrap_or_else(|| wrap_angle(q[j]).clamp(lower[j], upper[j]))
                 });
-                let frames = self.link_frames(q);
-                let foot = add(frames.pos[2], mat_vec(&frames.rot[2], self.params.foot));
-                (q, norm(sub(foot, target)), frames)
+                *out = self.link_frames(q);
+                let foot = add(out.pos[2], mat_vec(&out.rot[2], self.params.foot));
+                (q, norm(sub(foot, target)))
             } else {
                 continue;
             };
             match best {
                 Some((e, _, _)) if e <= error => {}
-                _ if nearest => best = Some((error, q, frames)),
+                _ if nearest => best = Some((error, q, *out)),
                 _ => {}
             }
         }
-        Analytic::Nearest(best)
+        Analytic::Nearest(best.map(|(error, q, frames)| {
+            *out = frames;
+            (error, q)
+        }))
     }
 
     /// The target relative to the HAA anchor, in the hip frame at q_HAA = 0 [m].
@@ -412,33 +453,33 @@ impl LegChain {
 
     /// A few Newton steps from an analytic solution, to take out the error of
     /// a slightly imperfect axis structure or of acos near a straight knee.
-    /// Returns the angles, the foot error [m] and the link frames at them.
-    fn polish(&self, q: Vec3, target: Vec3) -> (Vec3, f64, LinkFrames) {
+    /// Returns the angles and the foot error [m], with the link frames at
+    /// them in `frames`.
+    fn polish(&self, q: Vec3, target: Vec3, frames: &mut LinkFrames) -> (Vec3, f64) {
         let (lower, upper) = (self.params.lower, self.params.upper);
-        let fk = |q: Vec3| {
-            let f = self.link_frames(q);
-            let foot = add(f.pos[2], mat_vec(&f.rot[2], self.params.foot));
-            (foot, f)
-        };
-        let (mut q, (mut foot, mut frames)) = (q, fk(q));
+        let foot_of = |f: &LinkFrames| add(f.pos[2], mat_vec(&f.rot[2], self.params.foot));
+        *frames = self.link_frames(q);
+        let (mut q, mut foot) = (q, foot_of(frames));
         let mut error = norm(sub(foot, target));
         for _ in 0..4 {
             if error <= 1e-14 || error > NEWTON_RANGE {
                 break;
             }
-            let jacobian = Self::columns(&frames, foot, 2);
+            let jacobian = Self::columns(frames, foot, 2);
             let Some(dq) = solve(&jacobian, sub(target, foot)) else {
                 break;
             };
             let q_new = clamp_to(add(q, dq), lower, upper);
-            let (foot_new, frames_new) = fk(q_new);
+            let frames_new = self.link_frames(q_new);
+            let foot_new = foot_of(&frames_new);
             let e_new = norm(sub(foot_new, target));
             if !e_new.is_finite() || e_new >= error {
                 break;
             }
-            (q, foot, frames, error) = (q_new, foot_new, frames_new, e_new);
+            (q, foot, error) = (q_new, foot_new, e_new);
+            *frames = frames_new;
         }
-        (q, error, frames)
+        (q, error)
     }
 }
 
