@@ -58,10 +58,23 @@ class TimingConfig:
         LittleDog footstep (0.45–0.6 s of ~0.75 s), so this sets the speed.
     min_shift_s:
         Shortest shift phase [s] (four feet down, centre of pressure moved
-        into the next support triangle). The cart-table needs time to move
+        into the next support triangle) for a ZMP travel of
+        ``shift_travel_m`` or more. The cart-table needs time to move
         its ZMP: shorter shifts swing the trunk harder. The preview
         controller starts the move ahead, so 0.2 s suffices on the
         benchmark courses (0.3 s walked 20 % slower).
+    shift_travel_m:
+        ZMP travel [m] of a shift that takes the whole ``min_shift_s``; a
+        shorter one takes proportionally less, down to ``min_hold_s``. In a
+        crawl the swing already carries the ZMP into the next support
+        triangle before every front swing (the swings of one side share
+        two feet), so only the shifts that change sides travel (~25 mm
+        on LittleDog) and the others need next to none. 0 gives every
+        shift ``min_shift_s``.
+    min_hold_s:
+        Shortest shift phase [s] whatever the travel (at most
+        ``min_shift_s``): the landed foot's touchdown settles before the
+        next foot lifts.
     min_swing_s:
         Shortest swing phase [s].
     max_step_s:
@@ -74,13 +87,22 @@ class TimingConfig:
     velocity_margin: float = 1.6
     swing_velocity_margin: float = 1.1
     min_shift_s: float = 0.2
+    shift_travel_m: float = 0.0
+    min_hold_s: float = 0.06
     min_swing_s: float = 0.3
     max_step_s: float = 4.0
     settle_s: float = 0.8
 
+    def shift_floor(self, travel: float) -> float:
+        """Shortest shift phase [s] for a ZMP travel of ``travel`` [m]."""
+        if self.shift_travel_m <= 0:
+            return self.min_shift_s
+        part = min(1.0, max(travel, 0.0) / self.shift_travel_m)
+        return max(min(self.min_hold_s, self.min_shift_s), self.min_shift_s * part)
+
     def __post_init__(self) -> None:
         _check_positive(self, ("min_shift_s", "min_swing_s", "max_step_s"), "timing")
-        _check_nonnegative(self, ("settle_s",), "timing")
+        _check_nonnegative(self, ("settle_s", "shift_travel_m", "min_hold_s"), "timing")
         for name in ("velocity_margin", "swing_velocity_margin"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v >= 1):
