@@ -44,9 +44,12 @@ __all__ = [
 
 CRAWL_ORDER = ("LH", "LF", "RH", "RF")
 
-SNAP_RADIUS_M = 0.02
+SNAP_RADIUS_M = 0.025
 """How far [m] a re-plan may move a measured foot that stands off the planner's
-footholds onto the nearest one (:func:`~roughwalk.sim.foothold_snap.snap_to_footholds`)."""
+footholds onto the nearest one (:func:`~roughwalk.sim.foothold_snap.snap_to_footholds`):
+as far as the executor lets a re-plan start from planned footholds instead of the
+measured ones. On board AE (seed 0, default timing) a hind foot stood 2.06 cm past
+the foothold border after a reflex."""
 
 
 @dataclass(frozen=True)
