@@ -244,6 +244,12 @@ class TouchdownConfig:
     release_s:
         Time constant [s] with which a lifted foot's correction fades in
         flight, so that it lands where planned.
+
+    Measured (``roughwalk bench littledog --seeds 2 --classes sloped_rocks
+    --set executor.compute_time_scale=0`` with the fast opt-in timing):
+    ``enabled=false`` 0/2, on 2/2 (4.37 and 4.57 cm/s in two sweeps). The
+    push sweep with the default timing is unchanged by it (``roughwalk
+    bench push_recovery --direction 90`` / ``-90``: 16/17 and 15/17).
     """
 
     enabled: bool = True

@@ -138,6 +138,14 @@ class ZmpConfig:
         less. Falls back to the certificate when it collides or fails.
     support_margin:
         Distance [m] the shortcut point keeps inside its support triangle.
+        A larger margin plans more load on the third support foot (the
+        reflexes seen on the rock courses were a foot planned at ~3 N that
+        unloaded). With the fast opt-in timing (``timing.min_shift_s`` 0.1,
+        ``timing.min_swing_s`` 0.2, ``swing.time_law`` "joint"), 0.025
+        walked all 8 bench littledog runs of barrier, steps, round and
+        sloped rocks (2 seeds; 0.015: 6 of 8) but slower (steps 5.57 →
+        5.03 cm/s), and under the 1 N·s side push on flat ground 3 of the
+        first 12 runs fell (0.015: 2 of 34).
     gravity:
         Gravitational acceleration [m/s²].
     """
