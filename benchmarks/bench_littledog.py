@@ -125,36 +125,53 @@ def one_run(
     robot: forward 3 cm at a time up to 15 cm, and at each of those also
     3 cm to either side (:data:`START_NUDGES`, nearest first). The same
     where the robot, put down there, does not stand still until its first
-    step (:func:`stands_where_put`, from a short run up to ``PROBE_S``); if no
-    start holds, the first is used.
+    step (:func:`stands_where_put`, from a short run up to ``PROBE_S``, and
+    then from the run itself, whose longer planning may start from another
+    first pose); if no start holds, the last run made (or a run from the
+    first start) is the result.
     """
     sim = {k: v for k, v in sets if not k.startswith("trajectory.")}
     traj = {k.removeprefix("trajectory."): v for k, v in sets if k.startswith("trajectory.")}
     trajectory_config = rw.trajectories.trajectory_config(**traj) if traj else None
     began = time.perf_counter()
-    chosen = START_NUDGES[0]
+    result = None
     for dx, dy in START_NUDGES:
+        where = (start[0] + dx, start[1] + dy, start[2])
         # Put the robot down and let it settle: a short run up to the first step.
         probe = run(
             "littledog",
             spec,
-            (start[0] + dx, start[1] + dy, start[2]),
+            where,
             goal,
             trajectory_config=trajectory_config,
             **{**sim, "executor.initial_plan_s": 0.5, "outcome.time_limit_s": PROBE_S},
         )
-        if stands_where_put(probe):
-            chosen = (dx, dy)
+        if not stands_where_put(probe):
+            continue
+        result = run(
+            "littledog",
+            spec,
+            where,
+            goal,
+            disturbances=disturbances,
+            trajectory_config=trajectory_config,
+            **{"executor.initial_plan_s": plan_time, **sim},
+        )
+        # The run's longer planning can start from another first pose than
+        # the probe's, which may not hold either: then re-place the robot.
+        if stands_where_put(result):
             break
-    result = run(
-        "littledog",
-        spec,
-        (start[0] + chosen[0], start[1] + chosen[1], start[2]),
-        goal,
-        disturbances=disturbances,
-        trajectory_config=trajectory_config,
-        **{"executor.initial_plan_s": plan_time, **sim},
-    )
+    if result is None:
+        dx, dy = START_NUDGES[0]
+        result = run(
+            "littledog",
+            spec,
+            (start[0] + dx, start[1] + dy, start[2]),
+            goal,
+            disturbances=disturbances,
+            trajectory_config=trajectory_config,
+            **{"executor.initial_plan_s": plan_time, **sim},
+        )
     out = result.to_dict()
     out["wall_s"] = time.perf_counter() - began
     out["rescued"] = bool(out["success"] and out["reflexes"] > 0)

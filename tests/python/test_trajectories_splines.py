@@ -53,6 +53,26 @@ def test_step_timing_applies_margins_and_floors() -> None:
         TimingConfig(velocity_margin=0.5)
 
 
+def test_a_shift_that_moves_the_zmp_less_takes_less_down_to_the_hold() -> None:
+    limits = np.full((4, 3), 10.0)
+    still = np.zeros((2, 4, 3))
+    swing = np.zeros((41, 3))
+    cfg = TimingConfig(min_shift_s=0.2, shift_travel_m=0.02, min_hold_s=0.06)
+    assert cfg.shift_floor(0.03) == pytest.approx(0.2)
+    assert cfg.shift_floor(0.01) == pytest.approx(0.1)
+    assert cfg.shift_floor(0.0) == pytest.approx(0.06)
+    assert step_timing(still, swing, limits, cfg, 0, zmp_travel=0.01).shift_s == pytest.approx(0.1)
+    assert step_timing(still, swing, limits, cfg, 0).shift_s == pytest.approx(0.2)
+    # The joints' own limit still rules a short travel with a long joint path.
+    moving = still.copy()
+    moving[1, 0, 1] = 1.0
+    assert step_timing(moving, swing, limits, cfg, 0, zmp_travel=0.0).shift_s == pytest.approx(0.16)
+    # Without a travel scale every shift takes min_shift_s.
+    assert TimingConfig(min_shift_s=0.2).shift_floor(0.0) == pytest.approx(0.2)
+    # The hold never makes a shift longer than min_shift_s.
+    assert TimingConfig(min_shift_s=0.05, shift_travel_m=0.02).shift_floor(0.0) == 0.05
+
+
 @settings(max_examples=30, deadline=None)
 @given(
     st.floats(-0.02, 0.03),

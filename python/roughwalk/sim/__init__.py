@@ -17,6 +17,7 @@ from roughwalk.sim.config import (
     ReflexConfig,
     SimConfig,
     StabilizerConfig,
+    TouchdownConfig,
     WorldConfig,
 )
 from roughwalk.sim.cop_stabilizer import CopStabilizer, centre_of_pressure
@@ -51,6 +52,7 @@ __all__ = [
     "ControllerConfig",
     "IntegratorConfig",
     "StabilizerConfig",
+    "TouchdownConfig",
     "ReflexConfig",
     "OutcomeConfig",
     "ExecutorConfig",

@@ -40,6 +40,7 @@ from roughwalk.sim.recovery import blend_segment, hold_segment, pose_segment, re
 from roughwalk.sim.reflexes import ReflexMonitor
 from roughwalk.sim.run_log import RunLog
 from roughwalk.sim.runner import Runner
+from roughwalk.sim.touchdown_adapter import TouchdownAdapter
 from roughwalk.sim.trajectory_buffer import DesiredState, Segment, TrajectoryBuffer
 from roughwalk.sim.world import World
 from roughwalk.trajectories.euler import matrix_to_rpy
@@ -133,6 +134,7 @@ class Executor:
         self.controller = JointController(self.world, self.config.controller)
         self.integrator = LegIntegrator(robot, self.config.integrator, self.world.control_dt)
         self.stabilizer = CopStabilizer(self.config.stabilizer, self.world.control_dt)
+        self.touchdown = TouchdownAdapter(self.config.touchdown, self.world.control_dt)
         self.reflexes = ReflexMonitor(self.config.reflex)
         self.generator = FootstepTrajectoryGenerator(
             robot, self.planner_terrain, sdf=sdf, config=trajectory_config
@@ -313,7 +315,8 @@ class Executor:
                     desired = self._start_recovery(measured, desired, now)
                     steered = desired
                     mode = "recovery"
-            q_cmd = self.integrator.update(steered, measured, self.stabilizer.feet_offset(desired))
+            offset = self.stabilizer.feet_offset(desired) + self.touchdown.update(desired, measured)
+            q_cmd = self.integrator.update(steered, measured, offset)
             if desired.kind == "recovery":
                 q_cmd = self._catch(q_cmd, desired, measured)
             command = self.controller.command(q_cmd, desired, measured)
@@ -423,6 +426,7 @@ class Executor:
         self.buffer.clear()
         self.integrator.reset()
         self.stabilizer.reset()
+        self.touchdown.reset()
         self.reflexes.reset()
         segments, footholds = recovery_segment(
             self.robot,
@@ -557,6 +561,7 @@ class Executor:
         # (kept, they would move the feet off the measured stance at once).
         self.integrator.reset()
         self.stabilizer.reset()
+        self.touchdown.reset()
         self.buffer.append(hold_segment(holding, max(charged, 1e-3), now, kind="hold"))
         self.buffer.append(blend_segment(self.robot, holding, segment.sample(0.0), 0.2, ready))
         self.buffer.append(segment.with_ready_at(ready))

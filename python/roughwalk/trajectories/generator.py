@@ -17,8 +17,8 @@ known-infeasible trajectories", §5.3).
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
-from dataclasses import dataclass
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -171,8 +171,14 @@ class FootstepTrajectoryGenerator:
             )
         return self._controllers[key]
 
-    def nominal_timings(self, seq: StepSequence) -> list[StepTiming]:
-        """Each footstep's timing before any restart (§5.2), in whole CHOMP samples."""
+    def nominal_timings(
+        self, seq: StepSequence, travels: Sequence[float] | None = None
+    ) -> list[StepTiming]:
+        """Each footstep's timing before any restart (§5.2), in whole CHOMP samples.
+
+        ``travels`` (S,) [m]: how far each step's shift moves the ZMP
+        (:meth:`zmp_travels`), for the shift's floor; None: ``min_shift_s``.
+        """
         out = []
         previous = seq.initial_pose
         for k, step in enumerate(seq.steps):
@@ -202,9 +208,36 @@ class FootstepTrajectoryGenerator:
                 self.config.timing,
                 step.leg,
                 settle=k == len(seq.steps) - 1,
+                zmp_travel=None if travels is None else travels[k],
             )
             out.append(timing.quantized(self.dt))
             previous = pose
+        return out
+
+    def zmp_exit(
+        self, triangle: NDArray[np.float64], toward: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """Where a swing on the support ``triangle`` leaves the ZMP, heading for ``toward`` (2,).
+
+        As far toward the next anchor as its triangle allows with twice the
+        margin the support term asks for: with the support term's own
+        margin, the ZMP ended up to 1.6 mm outside the triangle just before
+        touchdown on LittleDog board AD, where the trunk is held and CHOMP
+        cannot pull it back.
+        """
+        margin = EXIT_MARGIN_FACTOR * self.config.chomp.zmp_margin
+        return closest_point_in_triangle(toward, triangle, margin)
+
+    def zmp_travels(self, seq: StepSequence, anchors: NDArray[np.float64]) -> list[float]:
+        """How far [m] each step's shift moves the ZMP: from the last swing's exit to its anchor.
+
+        ``anchors`` as in :class:`PreparedPlan` (the start, then one per step).
+        """
+        out = [float(np.linalg.norm(anchors[1] - anchors[0]))]
+        steps = seq.steps
+        for k in range(1, len(steps)):
+            left = self.zmp_exit(steps[k - 1].support_triangle, anchors[k + 1])
+            out.append(float(np.linalg.norm(anchors[k + 1] - left)))
         return out
 
     def shortcut_poses(self, seq: StepSequence) -> list[BodyKeyframe | None]:
@@ -328,15 +361,10 @@ class FootstepTrajectoryGenerator:
         points = [start.zmp_anchor, anchor, *anchors[k + 2 : last + 1]]
         if last == n_steps:
             points.append(anchors[n_steps + 1])
-        # Each swing moves the ZMP toward the next anchor, as far as its triangle
-        # allows with twice the margin the support term asks for: with the
-        # support term's own margin, the ZMP ended up to 1.6 mm outside the
-        # triangle just before touchdown on LittleDog board AD, where the trunk
-        # is held and CHOMP cannot pull it back.
-        margin = EXIT_MARGIN_FACTOR * self.config.chomp.zmp_margin
+        # Each swing moves the ZMP toward the next anchor (zmp_exit).
         steps = prepared.sequence.steps
         exits = [
-            closest_point_in_triangle(points[j + 2], steps[k + j].support_triangle, margin)
+            self.zmp_exit(steps[k + j].support_triangle, points[j + 2])
             if j + 2 < len(points)
             else points[j + 1]
             for j in range(len(window))
@@ -350,12 +378,12 @@ class FootstepTrajectoryGenerator:
     def prepare(self, plan: Any) -> PreparedPlan:
         """Read a plan and do the per-plan work: timings, shortcut poses, ZMP anchors."""
         seq = self.sequence(plan)
-        timings = self.nominal_timings(seq)
         shortcuts = self.shortcut_poses(seq)
         anchors = seq.anchors()
         for k, pose in enumerate(shortcuts):
             if pose is not None:
                 anchors[k + 1] = pose.com[:2]
+        timings = self.nominal_timings(seq, self.zmp_travels(seq, anchors))
         init = seq.initial_pose
         start = StartState(
             time=0.0,
@@ -383,8 +411,15 @@ class FootstepTrajectoryGenerator:
         step = prepared.sequence.steps[k]
         shortcut = prepared.shortcuts[k]
         pose = shortcut if use_shortcut and shortcut is not None else step.swing_pose
-        timing = prepared.timings[k].scaled(scale).quantized(self.dt)
         anchor = pose.com[:2].copy()
+        timing = prepared.timings[k].scaled(scale)
+        # The certificate's anchor (a restart after the shortcut) can lie
+        # farther from where the last swing left the ZMP than the plan's.
+        travel = float(np.linalg.norm(anchor - start.zmp_anchor))
+        floor = self.config.timing.shift_floor(travel)
+        if self.config.timing.shift_travel_m > 0 and timing.shift_s < floor:
+            timing = replace(timing, shift_s=floor)
+        timing = timing.quantized(self.dt)
         reference, horizon = self._window(prepared, k, start, timing, anchor)
         support_z = float(np.mean(step.support_triangle[:, 2]))
         state = build_initial_trajectory(

@@ -109,6 +109,7 @@ def step_timing(
     config: TimingConfig,
     swing_leg: int,
     settle: bool = False,
+    zmp_travel: float | None = None,
 ) -> StepTiming:
     """Phase durations [s] of one footstep from its joint motion.
 
@@ -129,14 +130,18 @@ def step_timing(
         Canonical index of the swing leg.
     settle:
         Add the final settling phase (the plan's last step).
+    zmp_travel:
+        How far [m] the shift moves the ZMP; the shift's floor is then
+        :meth:`TimingConfig.shift_floor` of it (None: ``min_shift_s``).
     """
     limits = np.asarray(velocity_limit, dtype=float).reshape(4, 3)
+    floor = config.min_shift_s if zmp_travel is None else config.shift_floor(zmp_travel)
     shift = min_joint_time(np.asarray(shift_path, dtype=float).reshape(-1, 12), limits.reshape(12))
     swing = min_profile_time(
         np.asarray(swing_profile, dtype=float).reshape(-1, 3), limits[swing_leg]
     )
     return StepTiming(
-        shift_s=min(max(config.min_shift_s, config.velocity_margin * shift), config.max_step_s),
+        shift_s=min(max(floor, config.velocity_margin * shift), config.max_step_s),
         swing_s=min(
             max(config.min_swing_s, config.swing_velocity_margin * swing), config.max_step_s
         ),

@@ -1,0 +1,76 @@
+"""Moving measured feet onto the planner's footholds before a re-plan.
+
+A re-plan starts from the feet where they stand (Zucker 2011, §6), but a
+foot that slid during a reflex can stand on a lattice cell the planner
+never allows as a foothold (a rock's flank or edge, whose terrain cost is
+infinite): the planner then refuses the whole start stance ("foot … is not
+on a foothold"), and the run ends although the foot is a few millimetres
+from ground the planner accepts (LittleDog large-rocks board AE).
+:func:`snap_to_footholds` moves only such feet to the nearest foothold
+cell within a small radius; the rest keep where they are. The planner's
+lattice and cost maps are read as its core reads them (nearest lattice
+cell, nearest terrain cell, unknown ground is no foothold).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from roughwalk.planning.footstep_planner import FootstepPlanner
+    from roughwalk.terrain.terrain import Terrain
+
+__all__ = ["snap_to_footholds"]
+
+
+def _foothold(
+    planner: FootstepPlanner, terrain: Terrain, xy: NDArray[np.float64], front: bool
+) -> NDArray[np.bool_]:
+    """Whether each lattice point ``xy`` (n, 2) [m] is a foothold for a front or hind foot."""
+    grid = planner.cost_front if front else planner.cost_hind
+    nx, ny = terrain.shape
+    gi = np.clip(np.round((xy[:, 0] - terrain.x0) / terrain.dx), 0, nx - 1).astype(int)
+    gj = np.clip(np.round((xy[:, 1] - terrain.y0) / terrain.dy), 0, ny - 1).astype(int)
+    cost = np.asarray(grid).reshape(nx, ny)[gi, gj]
+    return np.isfinite(cost) & np.asarray(terrain.is_known(xy), dtype=bool)
+
+
+def snap_to_footholds(
+    planner: FootstepPlanner,
+    terrain: Terrain,
+    feet: NDArray[np.float64],
+    radius: float,
+) -> tuple[NDArray[np.float64], list[int]]:
+    """Feet (4, 3) [m, canonical legs] with those off a foothold moved onto the nearest one.
+
+    Only x and y change. A foot with no foothold within ``radius`` [m] stays
+    (the planner will say why). Returns the feet and the legs moved.
+    """
+    x0, y0, h, nx, ny = planner.lattice
+    out = np.array(feet, dtype=float)
+    moved: list[int] = []
+    reach = int(np.ceil(radius / h))
+    offsets = np.array(
+        [(i, j) for i in range(-reach, reach + 1) for j in range(-reach, reach + 1)], dtype=float
+    )
+    offsets = offsets[np.hypot(offsets[:, 0], offsets[:, 1]) * h <= radius + 1e-12]
+    offsets = offsets[np.argsort(np.hypot(offsets[:, 0], offsets[:, 1]), kind="stable")]
+    for leg in range(4):
+        cell = np.round((out[leg, :2] - (x0, y0)) / h)
+        cells = cell + offsets
+        inside = (cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < nx) & (cells[:, 1] < ny)
+        cells = cells[inside]
+        if len(cells) == 0:
+            continue
+        xy = np.array([x0, y0]) + h * cells
+        ok = _foothold(planner, terrain, xy, front=leg < 2)
+        if ok[0] and np.all(cells[0] == cell):
+            continue
+        if not np.any(ok):
+            continue
+        out[leg, :2] = xy[int(np.argmax(ok))]
+        moved.append(leg)
+    return out, moved
