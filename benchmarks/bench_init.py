@@ -90,12 +90,12 @@ def _summary(
     limit: int,
     best: np.ndarray,
     cost_model: TaskCostModel | None,
-    fence: float,
+    fence: float | None,
 ) -> dict[str, Any]:
     solved = np.isin(data["status"], ("exact", "approximate"))
     feasible = feasible_mask(data)
     beyond = ~feasible | (data["cost"] > g_max)
-    beyond_fence = ~feasible | (data["cost"] > fence)
+    beyond_fence = ~feasible | (data["cost"] > (math.inf if fence is None else fence))
     beyond_task = None
     if cost_model is not None:
         per_task = cost_model.threshold(np.column_stack([data["start"], data["goal"]]))
@@ -150,9 +150,11 @@ def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:
         )
     # The start of the tail of the heuristic's held-out costs, by today's
     # fence: a model header's g_max may come from an older fence.
-    fence = cost_threshold(runs["Heuristic"]["cost"][feasible_mask(runs["Heuristic"])])
+    # (None when the heuristic solved no held-out task feasibly: double pallet.)
+    heuristic_ok = feasible_mask(runs["Heuristic"])
+    fence = cost_threshold(runs["Heuristic"]["cost"][heuristic_ok]) if heuristic_ok.any() else None
     if g_max is None:
-        g_max = fence
+        g_max = math.inf if fence is None else fence
     costs = np.stack([np.where(feasible_mask(v), v["cost"], np.inf) for v in runs.values()])
     best = costs.min(axis=0)
     return {
@@ -323,7 +325,7 @@ def main() -> None:
     best = learned[-1] if learned else None
     print(
         f"Figure 6, {args.env}: {args.tasks} held-out tasks, g_max {fig6['g_max']:.4g} "
-        f"(model), fence {fig6['heuristic_fence']:.4g} (heuristic's held-out costs)"
+        f"(model), fence {fig6['heuristic_fence'] or math.nan:.4g} (heuristic's held-out costs)"
     )
     print(
         f"{'initialiser':28s} {'conv.':>6s} {'med. it':>8s} {'med. s':>8s} {'>g_max':>7s} "
