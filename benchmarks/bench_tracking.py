@@ -52,6 +52,8 @@ class Job:
     index: int
     start: tuple[float, float, float]
     goal: tuple[float, float, float]
+    tracking: tuple[tuple[str, Any], ...] = ()
+    """TrackingConfig fields that differ from the default (``--tracking``)."""
 
 
 def _task_space(env: str) -> tuple[str, list[Any] | None, str]:
@@ -162,7 +164,9 @@ def run_job(job: Job) -> dict[str, Any]:
         row.update(success=False, reason="no trajectory")
         return row
     try:
-        outcome = track(result, robot, terrain)
+        from roughwalk.tracking import TrackingConfig
+
+        outcome = track(result, robot, terrain, TrackingConfig(**dict(job.tracking)))
     except Exception as e:  # noqa: BLE001
         row.update(success=False, reason=f"execution raised {type(e).__name__}: {e}")
         return row
@@ -275,6 +279,24 @@ def figure4(out_dir: Path) -> list[dict[str, Any]]:
     return rows
 
 
+def _tracking_settings(text: str) -> tuple[tuple[str, Any], ...]:
+    """``NAME=VALUE,...`` as TrackingConfig fields (true/false, numbers), checked by name."""
+    import dataclasses
+
+    from roughwalk.tracking import TrackingConfig
+
+    names = {f.name for f in dataclasses.fields(TrackingConfig)}
+    out = []
+    for item in filter(None, (v.strip() for v in text.split(","))):
+        name, _, value = item.partition("=")
+        if name not in names:
+            raise SystemExit(f"--tracking: TrackingConfig has no field {name!r}")
+        low = value.lower()
+        parsed: Any = low == "true" if low in ("true", "false") else float(value)
+        out.append((name, parsed))
+    return tuple(out)
+
+
 def main() -> None:
     """Run the benchmark and write its JSON."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -293,13 +315,19 @@ def main() -> None:
     parser.add_argument("--address", help="Ray cluster address")
     parser.add_argument("--figure4", action="store_true", help="also run Figure 4's comparison")
     parser.add_argument("--seed", type=int, default=0, help="task sampling seed")
+    parser.add_argument(
+        "--tracking",
+        default="",
+        help="controller settings that differ from the default, e.g. track_com=true",
+    )
     parser.add_argument("--json", type=Path, default=RESULTS, help="where to write the results")
     args = parser.parse_args()
 
     n = 100 if args.full else args.tasks
     iters = [int(v) for v in args.iters.split(",") if v]
+    tracking = _tracking_settings(args.tracking)
     inits = [v for v in args.init.split(",") if v]
-    notes = []
+    notes = [f"tracking settings: {dict(tracking)}"] if tracking else []
     if "learned" in inits:
         why = learned_available()
         if why:
@@ -322,7 +350,7 @@ def main() -> None:
                     continue
                 for it in iters:
                     for i, t in enumerate(tasks):
-                        jobs.append(Job(env, terrain, init, it, opt, i, t.start, t.goal))
+                        jobs.append(Job(env, terrain, init, it, opt, i, t.start, t.goal, tracking))
     print(f"{len(jobs)} solve-and-execute jobs ...", flush=True)
     executor = _executor(args.executor, args.workers, args.address)
     started = time.perf_counter()

@@ -153,3 +153,40 @@ def test_generate_selects_the_constraint_set(tmp_path: Path) -> None:
     assert constraint_set("terrain,dynamics") == ("terrain", "dynamics")
     with pytest.raises(ConfigError, match="unknown constraint set or names 'reach'"):
         constraint_set("reach")
+
+
+def test_best_per_task_keeps_each_task_s_feasible_cheapest_solve() -> None:
+    """Re-solves of the same tasks (Algorithm 1's rounds) merge into one row per task."""
+    from roughwalk.learning.filtering import best_per_task
+
+    def rows(cost: list[float], violation: list[float], tag: float) -> Dataset:
+        n = len(cost)
+        return Dataset.from_rows(
+            [
+                {
+                    "index": i,
+                    "start": np.zeros(3),
+                    "goal": np.zeros(3),
+                    "x0": np.full(2, tag),
+                    "x": np.full(2, tag),
+                    "cost": cost[i],
+                    "status": "exact",
+                    "iterations": 10,
+                    "max_violation": violation[i],
+                    "max_force_n": 0.0,
+                    "solve_time_s": 0.0,
+                    "first_iteration_s": 0.0,
+                    "time_per_iteration_s": 0.0,
+                }
+                for i in range(n)
+            ],
+            {},
+        )
+
+    first = rows([1.0, 2.0, 3.0, 4.0], [0.0, 0.0, 1.0, 0.0], 1.0)
+    second = rows([2.0, 1.0, 9.0], [0.0, 0.0, 0.0], 2.0)  # task 3 not re-solved
+    merged = best_per_task([first, second])
+    assert merged["index"].tolist() == [0, 1, 2, 3]
+    # Task 0: cheaper first; 1: cheaper second; 2: the feasible one, dearer; 3: only first.
+    assert merged["x"][:, 0].tolist() == [1.0, 2.0, 2.0, 1.0]
+    assert merged["cost"].tolist() == [1.0, 1.0, 9.0, 4.0]

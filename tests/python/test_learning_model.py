@@ -115,31 +115,77 @@ def test_layout_change_alone_is_refused_naming_the_variable_sets() -> None:
         model.check(nlp)
 
 
-def test_g_max_is_found_at_the_start_of_the_tail() -> None:
-    rng = np.random.default_rng(0)
-    body = np.exp(rng.normal(0.0, 0.1, size=200))  # costs around 1
-    tail = np.array([5.0, 20.0, 300.0, 1e4])  # poor local minima
-    g_max = cost_threshold(np.concatenate([body, tail]))
-    assert body.max() < g_max < tail.min()
-    n = len(body) + len(tail)
+def _cost_rows(cost: np.ndarray, starts: np.ndarray | None = None, **overrides: Any) -> Dataset:
+    n = len(cost)
     columns = {
         "index": np.arange(n),
-        "start": np.zeros((n, 3)),
+        "start": np.zeros((n, 3)) if starts is None else starts,
         "goal": np.zeros((n, 3)),
         "x0": np.zeros((n, 1)),
         "x": np.zeros((n, 1)),
-        "cost": np.concatenate([body, tail]),
+        "cost": np.asarray(cost, dtype=float),
         "status": np.array(["exact"] * n),
         "iterations": np.zeros(n, int),
-        "max_violation": np.where(np.arange(n) == 0, 1.0, 0.0),  # one infeasible
+        "max_violation": np.zeros(n),
         "max_force_n": np.zeros(n),
         "solve_time_s": np.zeros(n),
         "first_iteration_s": np.zeros(n),
         "time_per_iteration_s": np.zeros(n),
     }
-    result = filter_good(Dataset(columns, {}))
+    columns.update(overrides)
+    return Dataset(columns, {})
+
+
+def test_g_max_is_found_at_the_start_of_the_tail() -> None:
+    rng = np.random.default_rng(0)
+    body = np.exp(rng.normal(0.0, 0.1, size=200))  # costs around 1
+    tail = np.array([5.0, 20.0, 300.0, 1e4])  # poor local minima
+    cost = np.concatenate([body, tail])
+    g_max = cost_threshold(cost)
+    assert body.max() < g_max < tail.min()
+    one_infeasible = np.where(np.arange(len(cost)) == 0, 1.0, 0.0)
+    result = filter_good(_cost_rows(cost, max_violation=one_infeasible))
     assert result.automatic and result.n_good == len(body) - 1
-    assert filter_good(Dataset(columns, {}), g_max=10.0).n_good == len(body) - 1 + 1
+    given = filter_good(_cost_rows(cost, max_violation=one_infeasible), g_max=10.0)
+    assert given.n_good == len(body) - 1 + 1
+
+
+def test_g_max_is_not_dragged_past_a_heavy_tail() -> None:
+    """A quarter of the solves in poor minima: the fence still ends the body, before the tail.
+
+    Tukey's fence on all quartiles puts Q3 into the tail and ends beyond it
+    (session 5's single pallet: 6.8, above 352 of 353 costs).
+    """
+    rng = np.random.default_rng(1)
+    body = np.exp(rng.normal(0.0, 0.1, size=300))
+    tail = np.exp(rng.uniform(np.log(1.5), np.log(4.5), size=100))  # 25 %, 1.5 to 4.5
+    cost = np.concatenate([body, tail])
+    logs = np.log(cost)
+    q1, q3 = np.percentile(logs, [25.0, 75.0])
+    assert np.mean(tail <= np.exp(q3 + 1.5 * (q3 - q1))) > 0.3  # the plain fence: too lax
+    g_max = cost_threshold(cost)
+    assert np.mean(body > g_max) <= 0.01
+    assert np.mean(tail > g_max) >= 0.9
+
+
+def test_training_filter_keeps_costly_tasks_and_drops_their_poor_minima() -> None:
+    """With enough solves the filter is per task: costly tasks pass, poor minima anywhere do not."""
+    from roughwalk.learning.filtering import MIN_TASK_FIT, fit_task_cost
+
+    rng = np.random.default_rng(2)
+    n = 2 * MIN_TASK_FIT
+    starts = rng.uniform([-0.5, -0.75, -0.5], [0.5, 0.75, 0.5], size=(n, 3))
+    cost = np.exp(0.5 - 1.2 * starts[:, 0]) * rng.lognormal(0, 0.03, n)
+    poor = np.arange(n) % 20 == 0
+    cost[poor] *= 2.0
+    data = _cost_rows(cost, starts)
+    task_cost = fit_task_cost(data)
+    assert task_cost is not None
+    good = filter_good(data, task_cost=task_cost).good
+    assert not good[poor].any() and good[~poor].mean() >= 0.97
+    # One global threshold keeps the poor minima of cheap (near) starts.
+    assert filter_good(data).good[poor & (starts[:, 0] > 0.2)].any()
+    assert fit_task_cost(_cost_rows(cost[: MIN_TASK_FIT - 1], starts[: MIN_TASK_FIT - 1])) is None
 
 
 def test_multipliers_of_a_constraint_added_after_training_start_at_zero() -> None:

@@ -6,7 +6,9 @@ a two-layer network; later rounds learn from their predecessor's re-solves,
 with N_θ = 25 < N_h since learned guesses converge faster, and a
 three-layer network since more solutions pass the filter (§IV-B). g_max is
 set once, from the heuristic's costs, so that every round is filtered by
-the same standard.
+the same standard: a per-task g_max when the heuristic run has enough
+feasible solutions (:func:`~roughwalk.learning.filtering.fit_task_cost`),
+else one global g_max.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import numpy as np
 from roughwalk.learning.dataset import Dataset
 from roughwalk.learning.executors import Executor
 from roughwalk.learning.experience import generate, read_run
-from roughwalk.learning.filtering import filter_good
+from roughwalk.learning.filtering import filter_good, fit_task_cost
 from roughwalk.learning.model_file import LearnedModel
 from roughwalk.learning.problem_spec import ProblemSpec
 from roughwalk.learning.task_space import TaskSpace
@@ -82,7 +84,8 @@ def learned_init_rounds(
     """
     folder = Path(out)
     data = read_run(run)
-    threshold = filter_good(data, g_max).g_max
+    task_cost = fit_task_cost(data) if g_max is None else None
+    threshold = None if task_cost is not None else filter_good(data, g_max).g_max
     spec = ProblemSpec.from_dict(data.meta["problem"])
     space = TaskSpace.from_dict(data.meta["task_space"])
     indices = [int(i) for i in data["index"] if n_tasks is None or i < n_tasks]
@@ -92,6 +95,7 @@ def learned_init_rounds(
             data,
             layers=round_layers(k, width),
             g_max=threshold,
+            task_cost=task_cost,
             seed=seed,
             learned_round=k,
             note=f"LearnedInit-{k} from {Path(run).name}",

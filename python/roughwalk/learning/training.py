@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from roughwalk.errors import ConfigError, InvalidArgumentError
 from roughwalk.learning.dataset import Dataset
-from roughwalk.learning.filtering import filter_good
+from roughwalk.learning.filtering import best_per_task, filter_good, fit_task_cost
 from roughwalk.learning.mlp import MLP
 from roughwalk.learning.model_file import FEATURES, MODEL_FORMAT, MODEL_VERSION, LearnedModel
 from roughwalk.learning.problem_spec import ProblemSpec, build_problem, variable_categories
@@ -90,17 +90,17 @@ class TrainReport:
 
 
 def load_datasets(paths: Sequence[str | Path]) -> Dataset:
-    """Run folders (finished solves so far) or dataset files, appended into one."""
+    """Run folders (finished solves so far) or dataset files, merged into one.
+
+    A task solved in more than one of them (a re-solve from a later round's
+    model) keeps its best solve (:func:`~roughwalk.learning.filtering.best_per_task`).
+    """
     from roughwalk.learning.experience import read_run
 
-    out: Dataset | None = None
-    for path in paths:
-        p = Path(path)
-        data = read_run(p) if p.is_dir() else Dataset.load(p)
-        out = data if out is None else out.append(data)
-    if out is None:
+    datasets = [read_run(Path(p)) if Path(p).is_dir() else Dataset.load(p) for p in paths]
+    if not datasets:
         raise InvalidArgumentError("no dataset given")
-    return out
+    return best_per_task(datasets)
 
 
 def category_scales(
@@ -194,6 +194,7 @@ def train_model(
     note: str = "",
     learned_round: int = 1,
     extra: Mapping[str, Any] | None = None,
+    task_cost: TaskCostModel | None | str = "fit",
 ) -> tuple[LearnedModel, TrainReport]:
     """Filter ``data`` (D_good) and fit A_θ on it.
 
@@ -215,12 +216,19 @@ def train_model(
         Which LearnedInit round this model is (1: trained on heuristic solves).
     extra:
         More header fields (e.g. held-out figures).
+    task_cost:
+        Without ``g_max``, filter with this per-task g_max; "fit" (default)
+        fits one on ``data`` when it has enough feasible solutions
+        (:func:`~roughwalk.learning.filtering.fit_task_cost`), None uses the
+        global threshold.
 
     """
     if "problem" not in data.meta or "layout" not in data.meta:
         raise ConfigError("dataset meta lacks 'problem' or 'layout': not from an experience run")
     spec = ProblemSpec.from_dict(data.meta["problem"])
-    result = filter_good(data, g_max)
+    cost_model = fit_task_cost(data) if task_cost == "fit" else task_cost
+    assert not isinstance(cost_model, str)
+    result = filter_good(data, g_max, task_cost=cost_model)
     if result.n_good < 2:
         raise InvalidArgumentError(
             f"only {result.n_good} of {len(data)} solutions pass the filter "
@@ -274,6 +282,9 @@ def train_model(
             "n_good": report.n_good,
             "g_max": report.g_max,
             "g_max_automatic": report.automatic,
+            "filter": "per-task g_max (task_cost_model)"
+            if g_max is None and cost_model is not None
+            else "global g_max",
             "fit_seed": seed,
             "rmse": rmse,
             "task_cost_model": _task_cost_model(data, result.feasible),
