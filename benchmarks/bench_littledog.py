@@ -57,6 +57,8 @@ CLASSES = ("large_rocks", "round_rocks", "sloped_rocks", "logs", "gap", "barrier
 TARGET_CM_S = 7.2
 # A reflex this soon [s] after the first motion counts as the start not holding.
 PLACEMENT_S = 0.1
+# Time limit [s] of every plan under --expansions: a cap the budget should reach first.
+BUDGET_TIME_LIMIT_S = 300.0
 # Simulated time [s] of a start probe: the settling hold and the first step's start.
 PROBE_S = 0.5
 # Start offsets (forward [m], sideways [m]) tried in turn until the start
@@ -133,6 +135,9 @@ def one_run(
     sim = {k: v for k, v in sets if not k.startswith("trajectory.")}
     traj = {k.removeprefix("trajectory."): v for k, v in sets if k.startswith("trajectory.")}
     trajectory_config = rw.trajectories.trajectory_config(**traj) if traj else None
+    # With an expansion budget the probe plans as the run does, so that
+    # where the robot is put does not depend on the machine's speed either.
+    probe_plan_s = plan_time if int(sim.get("executor.plan_expansions", 0) or 0) else 0.5
     began = time.perf_counter()
     result = None
     for dx, dy in START_NUDGES:
@@ -144,7 +149,7 @@ def one_run(
             where,
             goal,
             trajectory_config=trajectory_config,
-            **{**sim, "executor.initial_plan_s": 0.5, "outcome.time_limit_s": PROBE_S},
+            **{**sim, "executor.initial_plan_s": probe_plan_s, "outcome.time_limit_s": PROBE_S},
         )
         if not stands_where_put(probe):
             continue
@@ -253,6 +258,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--plan-time", type=float, default=5.0, help="planning before the clock starts [s]"
     )
+    ap.add_argument(
+        "--expansions",
+        type=int,
+        default=0,
+        metavar="N",
+        help="plan and re-plan with a budget of N expanded states, computing time free "
+        f"and time limits of {BUDGET_TIME_LIMIT_S:g} s, so that results do not depend on "
+        "the machine's load (default: the anytime time limits)",
+    )
     ap.add_argument("--push", type=float, default=0.6, help="lateral push impulse [N·s]")
     ap.add_argument("--json", default=str(RESULTS), help="where to write the results")
     ap.add_argument("--jobs", type=int, default=1, help="runs at once (processes)")
@@ -265,6 +279,16 @@ def main(argv: list[str] | None = None) -> int:
         "setting (repeatable, dotted keys)",
     )
     args = ap.parse_args(argv)
+    if args.expansions < 0:
+        ap.error(f"--expansions must be >= 0, got {args.expansions}")
+    if args.expansions:
+        budget = [
+            "executor.compute_time_scale=0",
+            f"executor.plan_expansions={args.expansions}",
+            f"reflex.replan_budget_s={BUDGET_TIME_LIMIT_S:g}",
+        ]
+        args.set = [*budget, *args.set]  # the user's --set still wins
+        args.plan_time = BUDGET_TIME_LIMIT_S
     try:
         sim_sets, traj_sets = simulation_settings(args.set)
     except rw.ConfigError as e:
@@ -322,6 +346,7 @@ def main(argv: list[str] | None = None) -> int:
             seeds=seeds,
             full=args.full,
             plan_time_s=args.plan_time,
+            plan_expansions=args.expansions or None,
             jobs=args.jobs,
             overrides=dict(sets),
             load_average_before=list(load_before),

@@ -248,3 +248,32 @@ def test_cli_run_writes_json_report_and_replays(tmp_path: Path) -> None:
     assert main(["replay", str(out / "run.json"), "--video", str(gif),
                  "--size", "96x64", "--fps", "2"]) == 0  # fmt: skip
     assert gif.is_file() and gif.stat().st_size > 500
+
+
+@pytest.mark.skipif(not HAVE_PLANNER, reason="the compiled core predates the footstep planner")
+def test_plan_expansions_setting_makes_the_planner_stop_at_its_budget(littledog) -> None:
+    # bench littledog --expansions: runs that do not depend on the machine's speed.
+    terrain = roughwalk.load_terrain("flat")
+    results = [
+        run(
+            littledog,
+            terrain,
+            (0.25, 0.0, 0.0),
+            (1.5, 0.0),
+            planner="planner",
+            **{
+                "executor.compute_time_scale": 0.0,
+                "executor.plan_expansions": "150",  # as --set passes it
+                "executor.initial_plan_s": 30.0,
+                "outcome.time_limit_s": 0.2,
+            },
+        )
+        for _ in range(2)
+    ]
+    first, again = (r.plans[0] for r in results)
+    assert first.states_expanded <= 150 < 30 * 1000  # the budget, not the 30 s limit, ended it
+    assert first.elapsed_s < 10.0
+    assert [s.cost for s in first.solutions] == [s.cost for s in again.solutions]
+    assert first.footsteps == again.footsteps
+    with pytest.raises(roughwalk.ConfigError, match="plan_expansions"):
+        roughwalk.sim.sim_config(**{"executor.plan_expansions": -1})

@@ -468,13 +468,20 @@ class ExecutorConfig:
     initial_plan_s:
         Planning time [s] before the clock starts (the trials allowed 90 s;
         the anytime planner improves its plan until then).
+    plan_expansions:
+        A budget of expanded states for every plan and re-plan, on top of
+        the time limits; 0: none. With ``compute_time_scale`` 0 and time
+        limits the budget reaches first, a run no longer depends on how
+        fast the machine is at the moment (the planner's deterministic
+        mode).
     """
 
     compute_time_scale: float = 1.0
     initial_plan_s: float = 10.0
+    plan_expansions: int = 0
 
     def __post_init__(self) -> None:
-        _nonnegative(self, ("compute_time_scale",), "executor")
+        _nonnegative(self, ("compute_time_scale", "plan_expansions"), "executor")
         _positive(self, ("initial_plan_s",), "executor")
 
 

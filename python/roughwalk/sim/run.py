@@ -155,15 +155,16 @@ def run(
     seen = terrain_obj
     for d in disturbances:
         seen = d.planner_terrain(seen)
+    budget = cfg.executor.plan_expansions or None
     if isinstance(planner, str):
         if planner == "auto":
-            source: FootstepSource = default_source(robot_obj, seen)
+            source: FootstepSource = default_source(robot_obj, seen, expansions=budget)
         elif planner == "crawl":
             source = CrawlSource(robot_obj, seen)
         elif planner == "planner":
             from roughwalk.sim.footstep_source import PlannerSource
 
-            source = PlannerSource(robot_obj, seen)
+            source = PlannerSource(robot_obj, seen, expansions=budget)
         else:
             raise InvalidArgumentError(f"unknown planner {planner!r}; known: auto, planner, crawl")
     else:
