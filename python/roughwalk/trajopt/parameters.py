@@ -366,6 +366,8 @@ class TrajoptConfig:
         base-above-feet constraints.
     constraints:
         Names of the constraints to use (see :mod:`roughwalk.trajopt.constraints`).
+        ``force_between_nodes`` (opt-in, appended last) keeps the forces
+        unilateral and inside the friction pyramid between the force nodes too.
     costs:
         Cost weights (:class:`CostWeights`).
     swing_clearance:
