@@ -146,6 +146,14 @@ class ZmpConfig:
         sloped rocks (2 seeds; 0.015: 6 of 8) but slower (steps 5.57 →
         5.03 cm/s), and under the 1 N·s side push on flat ground 3 of the
         first 12 runs fell (0.015: 2 of 34).
+    min_support_load:
+        Least static load [N] the shortcut ZMP and each swing's exit point
+        plan on every foot of the support triangle (on top of
+        ``support_margin``; 0: none). The static loads are the ZMP's
+        barycentric coordinates times the weight: each edge moves in by
+        that share of the opposite foot's height over it, where this is more
+        than the margin. The shortcut presses the ZMP against the diagonal
+        edge, where the margin leaves the third foot ~3 N on LittleDog.
     gravity:
         Gravitational acceleration [m/s²].
     """
@@ -155,11 +163,12 @@ class ZmpConfig:
     preview_steps: int = 3
     shortcut: bool = True
     support_margin: float = 0.015
+    min_support_load: float = 0.0
     gravity: float = 9.81
 
     def __post_init__(self) -> None:
         _check_positive(self, ("tracking_weight", "jerk_weight", "gravity"), "zmp")
-        _check_nonnegative(self, ("support_margin",), "zmp")
+        _check_nonnegative(self, ("support_margin", "min_support_load"), "zmp")
         if not (isinstance(self.preview_steps, int) and self.preview_steps >= 1):
             raise ConfigError(f"zmp.preview_steps must be an integer ≥ 1, got {self.preview_steps}")
 
