@@ -208,14 +208,15 @@ def test_shrunk_triangle_plans_the_least_load_on_every_foot(seed: int, share: fl
     area = _area(tri)
     least = np.maximum(0.01 * edges / (2 * area), share)
     if least.sum() < 1.0:
-        assert np.all(loads >= share * mass * g - 1e-6)
+        # (static_contact_forces regularises its solve: loads to ~1e-5 N)
+        assert np.all(loads >= share * mass * g - 1e-4)
         margins, _ = polygon_margin(zmp, convex_polygon(tri))
         assert np.all(margins >= 0.01 - 1e-9)
     else:
         # One point, whose shares are in the ratio of what the edges ask for.
         np.testing.assert_allclose(inner, np.repeat(inner[:1], 3, axis=0), atol=1e-12)
         np.testing.assert_allclose(
-            loads / (mass * g), np.tile(least / least.sum(), (50, 1)), atol=1e-6
+            loads / (mass * g), np.tile(least / least.sum(), (50, 1)), atol=1e-4
         )
 
 

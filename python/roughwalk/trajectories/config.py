@@ -71,12 +71,12 @@ class TimingConfig:
         round rocks 2/2 at 3.32 → 4.17, sloped rocks 1/2 at 4.16 → 2/2 at
         4.37; the 1 N·s side push (``roughwalk bench push_recovery
         --direction 90`` / ``-90``) 16 and 16 of 17. It is not the default:
-        with 0.1 here the ZMP leaves the support polygon in one of the six
-        steps of a flat straight crawl and in the Figure 8 barrier step
-        (both invalid after CHOMP's restarts; 0.2 s here with the rest of
-        the fast timing keeps the crawl valid), and that rest alone falls
-        under the side push at 2 of the first 11 times to the left and 3
-        of the first 12 to the right.
+        with 0.1 here the ZMP leaves the support polygon in the first step
+        of a flat straight crawl and in the Figure 8 barrier step (both
+        invalid after CHOMP's restarts; ``first_shift_s`` 0.2 mends both
+        but loses pushes), and the rest of the fast timing alone (0.2 here)
+        falls under the side push at 2 of the first 11 times to the left
+        and 3 of the first 12 to the right.
     shift_travel_m:
         ZMP travel [m] of a shift that takes the whole ``min_shift_s``; a
         shorter one takes proportionally less, down to ``min_hold_s``. In a
@@ -96,6 +96,19 @@ class TimingConfig:
         Shortest shift phase [s] whatever the travel (at most
         ``min_shift_s``): the landed foot's touchdown settles before the
         next foot lifts.
+    first_shift_s:
+        Shortest shift phase [s] of a plan's first step, which starts from
+        rest (at most ``min_shift_s``, the default 0: no floor of its own).
+        The cart-table moves its ZMP only by accelerating the CoM, and from
+        rest the preview controller has no earlier motion to start the move
+        in: with the fast timing's 0.1 s the ZMP left the support polygon
+        in the first of six steps of a flat straight crawl and in the
+        Figure 8 barrier step (0.15 s: the latter too); 0.2 s keeps both
+        valid. With the fast timing and 0.2 here the repeatable bench
+        walks sloped rocks 2/2 at 5.00 cm/s (4.37 without) and steps 2/2 at
+        5.16 (5.21), but the side push survives 16 of 17 to the left and
+        only 13 to the right (16 without: falls at 2.0–2.4 s and 4.4 s),
+        so it stays 0.
     min_swing_s:
         Shortest swing phase [s].
     max_step_s:
@@ -110,6 +123,7 @@ class TimingConfig:
     min_shift_s: float = 0.2
     shift_travel_m: float = 0.0
     min_hold_s: float = 0.06
+    first_shift_s: float = 0.0
     min_swing_s: float = 0.3
     max_step_s: float = 4.0
     settle_s: float = 0.8
@@ -123,7 +137,9 @@ class TimingConfig:
 
     def __post_init__(self) -> None:
         _check_positive(self, ("min_shift_s", "min_swing_s", "max_step_s"), "timing")
-        _check_nonnegative(self, ("settle_s", "shift_travel_m", "min_hold_s"), "timing")
+        _check_nonnegative(
+            self, ("settle_s", "shift_travel_m", "min_hold_s", "first_shift_s"), "timing"
+        )
         for name in ("velocity_margin", "swing_velocity_margin"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v >= 1):

@@ -215,6 +215,7 @@ class FootstepTrajectoryGenerator:
                 step.leg,
                 settle=k == len(seq.steps) - 1,
                 zmp_travel=None if travels is None else travels[k],
+                from_rest=k == 0,
             )
             out.append(timing.quantized(self.dt))
             previous = pose
