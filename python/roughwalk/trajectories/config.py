@@ -105,10 +105,11 @@ class TimingConfig:
         in the first of six steps of a flat straight crawl and in the
         Figure 8 barrier step (0.15 s: the latter too); 0.2 s keeps both
         valid. With the fast timing and 0.2 here the repeatable bench
-        walks sloped rocks 2/2 at 5.00 cm/s (4.37 without) and steps 2/2 at
-        5.16 (5.21), but the side push survives 16 of 17 to the left and
-        only 13 to the right (16 without: falls at 2.0–2.4 s and 4.4 s),
-        so it stays 0.
+        walks all 8 runs, sloped rocks at 5.00 cm/s (4.37 without), steps
+        5.16 (5.21), barrier 5.67 (5.71), but round rocks at 2.99 with 3
+        reflexes (4.17, none), and the side push survives 16 of 17 to the
+        left and only 13 to the right (16 without: falls at 2.0–2.4 s and
+        4.4 s), so it stays 0.
     min_swing_s:
         Shortest swing phase [s].
     max_step_s:
