@@ -73,6 +73,31 @@ def test_a_shift_that_moves_the_zmp_less_takes_less_down_to_the_hold() -> None:
     assert TimingConfig(min_shift_s=0.05, shift_travel_m=0.02).shift_floor(0.0) == 0.05
 
 
+def test_a_step_from_rest_keeps_the_first_shift_floor() -> None:
+    limits = np.full((4, 3), 10.0)
+    still = np.zeros((2, 4, 3))
+    swing = np.zeros((41, 3))
+    cfg = TimingConfig(min_shift_s=0.1, first_shift_s=0.2)
+    assert step_timing(still, swing, limits, cfg, 0).shift_s == pytest.approx(0.1)
+    assert step_timing(still, swing, limits, cfg, 0, from_rest=True).shift_s == pytest.approx(0.2)
+    # No floor of its own below min_shift_s.
+    fast = TimingConfig(min_shift_s=0.2, first_shift_s=0.1)
+    assert step_timing(still, swing, limits, fast, 0, from_rest=True).shift_s == pytest.approx(0.2)
+    # The generator's first step of a plan is the one from rest.
+    robot = rw.load_robot("littledog")
+    terrain = rw.load_terrain("flat:length=1.2,width=0.5")
+    plan = rw.trajectories.straight_crawl_plan(robot, terrain, (0.3, 0.0), steps=3)
+    config = rw.trajectories.trajectory_config(
+        **{"timing.min_shift_s": 0.1, "timing.first_shift_s": 0.2}
+    )
+    from roughwalk.trajectories.generator import FootstepTrajectoryGenerator
+
+    gen = FootstepTrajectoryGenerator(robot, terrain, config=config)
+    shifts = [t.shift_s for t in gen.nominal_timings(gen.sequence(plan))]
+    assert shifts[0] >= 0.2 - 1e-9
+    assert min(shifts[1:]) < 0.2 - 1e-9
+
+
 @settings(max_examples=30, deadline=None)
 @given(
     st.floats(-0.02, 0.03),

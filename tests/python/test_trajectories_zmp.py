@@ -168,3 +168,70 @@ def test_shrunk_triangle_keeps_the_margin() -> None:
 
     margins, _ = polygon_margin(inner, convex_polygon(tri))
     np.testing.assert_allclose(margins, 0.01, atol=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10_000))
+def test_shrunk_triangle_by_margin_alone_is_the_incentre_scaling(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    tri = rng.uniform(-0.1, 0.1, (3, 2))
+    a, b, c = (np.linalg.norm(tri[(i + 1) % 3] - tri[(i + 2) % 3]) for i in range(3))
+    centre = (a * tri[0] + b * tri[1] + c * tri[2]) / (a + b + c)
+    area = _area(tri)
+    r = 2.0 * area / (a + b + c)
+    margin = rng.uniform(0.0, 1.5 * r)
+    expected = centre + max(r - margin, 0.0) / r * (tri - centre)
+    np.testing.assert_allclose(shrink_triangle(tri, margin), expected, atol=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10_000), st.floats(0.0, 0.3))
+def test_shrunk_triangle_plans_the_least_load_on_every_foot(seed: int, share: float) -> None:
+    rng = np.random.default_rng(seed)
+    tri = rng.uniform(-0.1, 0.1, (3, 2))
+    inner = shrink_triangle(tri, 0.01, min_share=share)
+    from roughwalk.trajectories.contact_forces import static_contact_forces
+    from roughwalk.trajectories.support_polygon import convex_polygon, polygon_margin
+
+    # Any point of the inner triangle: at least the share of the weight on
+    # every foot, and the margin from every edge (while the triangle is not
+    # shrunk to a point).
+    w = rng.dirichlet(np.ones(3), 50)
+    zmp = w @ inner
+    feet = np.zeros((50, 4, 3))
+    feet[:, :3, :2] = tri
+    feet[:, 3, :2] = 1.0
+    support = np.tile([True, True, True, False], (50, 1))
+    mass, g = 2.0, 9.81
+    loads = static_contact_forces(feet, support, zmp, np.zeros((50, 3)), mass, g)[:, :3, 2]
+    edges = np.linalg.norm(tri[[1, 2, 0]] - tri[[2, 0, 1]], axis=1)
+    area = _area(tri)
+    least = np.maximum(0.01 * edges / (2 * area), share)
+    if least.sum() < 1.0:
+        # (static_contact_forces regularises its solve: loads to ~1e-5 N)
+        assert np.all(loads >= share * mass * g - 1e-4)
+        margins, _ = polygon_margin(zmp, convex_polygon(tri))
+        assert np.all(margins >= 0.01 - 1e-9)
+    else:
+        # One point, whose shares are in the ratio of what the edges ask for.
+        np.testing.assert_allclose(inner, np.repeat(inner[:1], 3, axis=0), atol=1e-12)
+        np.testing.assert_allclose(
+            loads / (mass * g), np.tile(least / least.sum(), (50, 1)), atol=1e-4
+        )
+
+
+def test_the_least_load_keeps_the_zmp_off_the_diagonal() -> None:
+    # A crawl's support triangle: front left, hind right, and the third foot
+    # (front right) 12 cm off the diagonal; 18 % of the weight on it keeps
+    # the ZMP 2.16 cm off the diagonal, where a margin of 1.5 cm put 12.5 %.
+    tri = np.array([[0.1, 0.075], [-0.1, -0.075], [0.1, -0.075]])
+    diagonal = np.array([0.6, -0.8])  # unit normal of the diagonal, toward the third foot
+    by_margin = (shrink_triangle(tri, 0.015) - tri[0]) @ diagonal
+    assert float(np.min(by_margin)) == pytest.approx(0.015, abs=1e-9)
+    by_load = (shrink_triangle(tri, 0.015, min_share=0.18) - tri[0]) @ diagonal
+    assert float(np.min(by_load)) == pytest.approx(0.18 * 0.12, abs=1e-9)
+
+
+def _area(tri: np.ndarray) -> float:
+    u, v = tri[1] - tri[0], tri[2] - tri[0]
+    return 0.5 * abs(float(u[0] * v[1] - u[1] * v[0]))

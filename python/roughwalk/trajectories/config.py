@@ -62,7 +62,21 @@ class TimingConfig:
         ``shift_travel_m`` or more. The cart-table needs time to move
         its ZMP: shorter shifts swing the trunk harder. The preview
         controller starts the move ahead, so 0.2 s suffices on the
-        benchmark courses (0.3 s walked 20 % slower).
+        benchmark courses (0.3 s walked 20 % slower). The fast timing
+        (0.1 here, ``min_swing_s`` 0.2, ``swing.time_law`` "joint")
+        against the defaults, the planner's budget fixed so that runs
+        repeat (``roughwalk bench littledog --classes
+        barrier,steps,round_rocks,sloped_rocks --expansions 40000 --seeds
+        2``): barrier 2/2 at 3.99 → 5.71 cm/s, steps 2/2 at 3.76 → 5.21,
+        round rocks 2/2 at 3.32 → 4.17, sloped rocks 1/2 at 4.16 → 2/2 at
+        4.37; the 1 N·s side push (``roughwalk bench push_recovery
+        --direction 90`` / ``-90``) 16 and 16 of 17. It is not the default:
+        with 0.1 here the ZMP leaves the support polygon in the first step
+        of a flat straight crawl and in the Figure 8 barrier step (both
+        invalid after CHOMP's restarts; ``first_shift_s`` 0.2 mends both
+        but loses pushes), and the rest of the fast timing alone (0.2 here)
+        falls under the side push at 2 of the first 11 times to the left
+        and 3 of the first 12 to the right.
     shift_travel_m:
         ZMP travel [m] of a shift that takes the whole ``min_shift_s``; a
         shorter one takes proportionally less, down to ``min_hold_s``. In a
@@ -82,6 +96,20 @@ class TimingConfig:
         Shortest shift phase [s] whatever the travel (at most
         ``min_shift_s``): the landed foot's touchdown settles before the
         next foot lifts.
+    first_shift_s:
+        Shortest shift phase [s] of a plan's first step, which starts from
+        rest (at most ``min_shift_s``, the default 0: no floor of its own).
+        The cart-table moves its ZMP only by accelerating the CoM, and from
+        rest the preview controller has no earlier motion to start the move
+        in: with the fast timing's 0.1 s the ZMP left the support polygon
+        in the first of six steps of a flat straight crawl and in the
+        Figure 8 barrier step (0.15 s: the latter too); 0.2 s keeps both
+        valid. With the fast timing and 0.2 here the repeatable bench
+        walks all 8 runs, sloped rocks at 5.00 cm/s (4.37 without), steps
+        5.16 (5.21), barrier 5.67 (5.71), but round rocks at 2.99 with 3
+        reflexes (4.17, none), and the side push survives 16 of 17 to the
+        left and only 13 to the right (16 without: falls at 2.0–2.4 s and
+        4.4 s), so it stays 0.
     min_swing_s:
         Shortest swing phase [s].
     max_step_s:
@@ -96,6 +124,7 @@ class TimingConfig:
     min_shift_s: float = 0.2
     shift_travel_m: float = 0.0
     min_hold_s: float = 0.06
+    first_shift_s: float = 0.0
     min_swing_s: float = 0.3
     max_step_s: float = 4.0
     settle_s: float = 0.8
@@ -109,7 +138,9 @@ class TimingConfig:
 
     def __post_init__(self) -> None:
         _check_positive(self, ("min_shift_s", "min_swing_s", "max_step_s"), "timing")
-        _check_nonnegative(self, ("settle_s", "shift_travel_m", "min_hold_s"), "timing")
+        _check_nonnegative(
+            self, ("settle_s", "shift_travel_m", "min_hold_s", "first_shift_s"), "timing"
+        )
         for name in ("velocity_margin", "swing_velocity_margin"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v >= 1):
@@ -146,6 +177,24 @@ class ZmpConfig:
         sloped rocks (2 seeds; 0.015: 6 of 8) but slower (steps 5.57 →
         5.03 cm/s), and under the 1 N·s side push on flat ground 3 of the
         first 12 runs fell (0.015: 2 of 34).
+    min_support_load:
+        Least static load [N] the shortcut ZMP and each swing's exit point
+        plan on every foot of the support triangle (on top of
+        ``support_margin``; 0: none). The static loads are the ZMP's
+        barycentric coordinates times the weight: each edge moves in by
+        that share of the opposite foot's height over it, where this is more
+        than the margin. The shortcut presses the ZMP against the diagonal
+        edge, where the margin leaves the third foot ~3 N on LittleDog.
+        Measured with the fast timing (``timing.min_shift_s`` 0.1,
+        ``timing.min_swing_s`` 0.2, ``swing.time_law`` "joint"; ``roughwalk
+        bench littledog --classes barrier,steps,round_rocks,sloped_rocks
+        --expansions 40000 --seeds 2``), 0 → 5 N: all 8 runs still walk, but
+        steps seed 1 still fires its reflex (LH, planned 4.7 N instead of
+        3.1 N, carries nothing at 7.0 s while RF swings onto the 11.8 cm
+        step: the trunk tips over the diagonal by more than the load moves
+        the ZMP), and the rock runs get slower with more reflexes (round
+        rocks 4.17 → 3.34 cm/s, 0 → 2 reflexes; sloped rocks 4.37 → 3.97;
+        barrier 5.71 → 5.61, steps 5.21 → 5.35), so it stays 0.
     gravity:
         Gravitational acceleration [m/s²].
     """
@@ -155,11 +204,12 @@ class ZmpConfig:
     preview_steps: int = 3
     shortcut: bool = True
     support_margin: float = 0.015
+    min_support_load: float = 0.0
     gravity: float = 9.81
 
     def __post_init__(self) -> None:
         _check_positive(self, ("tracking_weight", "jerk_weight", "gravity"), "zmp")
-        _check_nonnegative(self, ("support_margin",), "zmp")
+        _check_nonnegative(self, ("support_margin", "min_support_load"), "zmp")
         if not (isinstance(self.preview_steps, int) and self.preview_steps >= 1):
             raise ConfigError(f"zmp.preview_steps must be an integer ≥ 1, got {self.preview_steps}")
 

@@ -157,6 +157,12 @@ class FootstepTrajectoryGenerator:
             plan, self.wb, self.config.zmp.support_margin, terrain=self.terrain
         )
 
+    @property
+    def min_support_share(self) -> float:
+        """``zmp.min_support_load`` as a share of the robot's weight."""
+        z = self.config.zmp
+        return z.min_support_load / (self.wb.mass * z.gravity)
+
     def controller(self, com_height: float) -> ZmpPreviewController:
         """The preview controller for a CoM height [m] (cached per millimetre)."""
         key = max(int(round(com_height * 1000)), 1)
@@ -209,6 +215,7 @@ class FootstepTrajectoryGenerator:
                 step.leg,
                 settle=k == len(seq.steps) - 1,
                 zmp_travel=None if travels is None else travels[k],
+                from_rest=k == 0,
             )
             out.append(timing.quantized(self.dt))
             previous = pose
@@ -226,7 +233,7 @@ class FootstepTrajectoryGenerator:
         cannot pull it back.
         """
         margin = EXIT_MARGIN_FACTOR * self.config.chomp.zmp_margin
-        return closest_point_in_triangle(toward, triangle, margin)
+        return closest_point_in_triangle(toward, triangle, margin, self.min_support_share)
 
     def zmp_travels(self, seq: StepSequence, anchors: NDArray[np.float64]) -> list[float]:
         """How far [m] each step's shift moves the ZMP: from the last swing's exit to its anchor.
@@ -251,7 +258,12 @@ class FootstepTrajectoryGenerator:
         for k, step in enumerate(seq.steps):
             a = anchors[k + 1]
             p = shortcut_anchor(
-                anchors[k], a, anchors[k + 2], step.support_triangle, self.config.zmp.support_margin
+                anchors[k],
+                a,
+                anchors[k + 2],
+                step.support_triangle,
+                self.config.zmp.support_margin,
+                min_share=self.min_support_share,
             )
             if float(np.linalg.norm(p - a)) < 1e-4:
                 out.append(None)

@@ -110,6 +110,7 @@ def step_timing(
     swing_leg: int,
     settle: bool = False,
     zmp_travel: float | None = None,
+    from_rest: bool = False,
 ) -> StepTiming:
     """Phase durations [s] of one footstep from its joint motion.
 
@@ -133,9 +134,14 @@ def step_timing(
     zmp_travel:
         How far [m] the shift moves the ZMP; the shift's floor is then
         :meth:`TimingConfig.shift_floor` of it (None: ``min_shift_s``).
+    from_rest:
+        The step starts from rest (a plan's first): its shift takes at
+        least :attr:`TimingConfig.first_shift_s` too.
     """
     limits = np.asarray(velocity_limit, dtype=float).reshape(4, 3)
     floor = config.min_shift_s if zmp_travel is None else config.shift_floor(zmp_travel)
+    if from_rest:
+        floor = max(floor, config.first_shift_s)
     shift = min_joint_time(np.asarray(shift_path, dtype=float).reshape(-1, 12), limits.reshape(12))
     swing = min_profile_time(
         np.asarray(swing_profile, dtype=float).reshape(-1, 3), limits[swing_leg]

@@ -132,16 +132,37 @@ def _incircle(tri: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
     return centre, 2.0 * area / perimeter
 
 
-def shrink_triangle(triangle: ArrayLike, margin: float) -> NDArray[np.float64]:
+def shrink_triangle(
+    triangle: ArrayLike, margin: float, min_share: float = 0.0
+) -> NDArray[np.float64]:
     """The triangle (3, 2) [m] of points at least ``margin`` [m] inside ``triangle``.
 
-    Every edge moves in by ``margin``: the triangle scaled about its incentre
-    by (r − margin)/r. A margin beyond the inradius r leaves the incentre.
+    Every edge moves in by ``margin``; with ``min_share`` also by that share
+    of the height of the opposite corner (where it is more): a ZMP there
+    puts at least that share of the weight on every foot of the triangle
+    (the static loads are the ZMP's barycentric coordinates). Too much of
+    either leaves one point: the incentre for ``margin`` alone, in general
+    the point whose coordinates are in the ratio of the edges' demands.
     """
     tri = np.asarray(triangle, dtype=float)[:, :2]
     centre, r = _incircle(tri)
-    scale = max(r - margin, 0.0) / r if r > 0 else 0.0
-    return centre + scale * (tri - centre)
+    if r <= 0:
+        return np.repeat(centre[None], 3, axis=0)
+    area = 0.5 * abs(
+        (tri[1, 0] - tri[0, 0]) * (tri[2, 1] - tri[0, 1])
+        - (tri[2, 0] - tri[0, 0]) * (tri[1, 1] - tri[0, 1])
+    )
+    # Height of corner i over the opposite edge, and the least barycentric
+    # coordinate of corner i the margin and the share ask for.
+    edges = np.linalg.norm(tri[[1, 2, 0]] - tri[[2, 0, 1]], axis=1)
+    least = np.maximum(margin * edges / (2.0 * area), min_share)
+    total = float(least.sum())
+    if total >= 1.0:
+        point = (least / total) @ tri
+        return np.repeat(point[None], 3, axis=0)
+    weights = np.tile(least, (3, 1))
+    weights[np.arange(3), np.arange(3)] = 1.0 - (total - least)
+    return weights @ tri
 
 
 def inside_triangle(
@@ -159,11 +180,11 @@ def inside_triangle(
 
 
 def closest_point_in_triangle(
-    point: ArrayLike, triangle: ArrayLike, margin: float
+    point: ArrayLike, triangle: ArrayLike, margin: float, min_share: float = 0.0
 ) -> NDArray[np.float64]:
-    """The point (2,) of ``triangle`` shrunk by ``margin`` [m] nearest to ``point`` (2,) [m]."""
+    """The point (2,) of ``triangle`` shrunk (:func:`shrink_triangle`) nearest to ``point`` [m]."""
     p = np.asarray(point, dtype=float)[:2]
-    inner = shrink_triangle(triangle, margin)
+    inner = shrink_triangle(triangle, margin, min_share)
     if inside_triangle(p[None], inner)[0]:
         return p.copy()
     best, best_d = inner[0], np.inf
@@ -185,18 +206,20 @@ def shortcut_anchor(
     triangle: ArrayLike,
     margin: float,
     samples: int = 64,
+    min_share: float = 0.0,
 ) -> NDArray[np.float64]:
     """The footnote-2 shortcut ZMP (2,) [m] for one step.
 
     Minimises |previous − p| + |p − following| over p in ``triangle``
-    shrunk by ``margin``, ties broken toward ``anchor`` (the certificate's);
+    shrunk by ``margin`` and ``min_share`` (:func:`shrink_triangle`), ties
+    broken toward ``anchor`` (the certificate's);
     found among dense samples of the segment previous–following inside the
     shrunk triangle and of its boundary.
     """
     a = np.asarray(previous, dtype=float)[:2]
     b = np.asarray(following, dtype=float)[:2]
     home = np.asarray(anchor, dtype=float)[:2]
-    inner = shrink_triangle(triangle, margin)
+    inner = shrink_triangle(triangle, margin, min_share)
     s = np.linspace(0.0, 1.0, samples + 1)[:, None]
     on_segment = a + s * (b - a)
     on_segment = on_segment[inside_triangle(on_segment, inner, tol=1e-12)]
