@@ -6,6 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from _sim_states import standing_step
 
 import roughwalk
 from roughwalk.errors import ConfigError
@@ -14,7 +15,6 @@ from roughwalk.sim.config import IntegratorConfig, StabilizerConfig
 from roughwalk.sim.cop_stabilizer import CopStabilizer, centre_of_pressure
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
-from roughwalk.sim.recovery import pose_segment
 from roughwalk.sim.runner import Runner
 from roughwalk.sim.world import World
 
@@ -22,24 +22,6 @@ from roughwalk.sim.world import World
 @pytest.fixture(scope="module")
 def littledog() -> roughwalk.Robot:
     return roughwalk.load_robot("littledog")
-
-
-def standing_step(robot: roughwalk.Robot) -> object:
-    """The desired state of a footstep that stands still in the nominal stance on flat ground."""
-    st = robot.nominal_stance
-    base = np.array([0.5, 0.0, st.base_height])
-    feet = st.feet + base
-    segment = pose_segment(
-        robot,
-        np.array([base, base]),
-        np.zeros((2, 3)),
-        np.array([feet, feet]),
-        np.ones(4, dtype=bool),
-        1.0,
-        "step",
-        0.0,
-    )
-    return segment.sample(0.0)
 
 
 def test_centre_of_pressure_is_the_force_weighted_mean_of_the_feet() -> None:

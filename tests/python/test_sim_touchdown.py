@@ -7,12 +7,12 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from _sim_states import standing_step
 
 import roughwalk
 from roughwalk.errors import ConfigError
 from roughwalk.robots._rotations import quat_multiply, quat_to_matrix
 from roughwalk.sim.config import TouchdownConfig
-from roughwalk.sim.recovery import pose_segment
 from roughwalk.sim.reflexes import orientation_error
 from roughwalk.sim.touchdown_adapter import TouchdownAdapter
 
@@ -22,21 +22,7 @@ DT = 0.002
 @pytest.fixture(scope="module")
 def stance() -> object:
     """The desired state of a footstep standing in LittleDog's nominal stance, trunk pitched."""
-    robot = roughwalk.load_robot("littledog")
-    st = robot.nominal_stance
-    base = np.array([0.5, 0.0, st.base_height])
-    feet = st.feet + base
-    segment = pose_segment(
-        robot,
-        np.array([base, base]),
-        np.array([[0.0, 0.1, 0.0], [0.0, 0.1, 0.0]]),
-        np.array([feet, feet]),
-        np.ones(4, dtype=bool),
-        1.0,
-        "step",
-        0.0,
-    )
-    return segment.sample(0.0)
+    return standing_step(roughwalk.load_robot("littledog"), (0.0, 0.1, 0.0))
 
 
 def measured_like(desired: object, fz: list[float], quat: np.ndarray | None = None) -> object:

@@ -13,6 +13,7 @@ from roughwalk.trajopt import (
     TOWR_ANYMAL,
     Formulation,
     HeuristicInitializer,
+    SingleRigidBody,
     TerrainModel,
     make_gait,
     melon_config,
@@ -245,6 +246,21 @@ def test_terrain_gradient_and_edges() -> None:
     assert cost[0] > 0.9 and cost[1] < cost[0] and cost[2] < 1e-3 and cost[3] < 1e-3
 
 
+def _pallet_walk(
+    optimize_durations: bool, reach: bool
+) -> tuple[Formulation, SingleRigidBody, TerrainModel]:
+    """A 4-step Melon walk onto the single pallet, with or without the leg-reach rows."""
+    constraints = MELON_REACH_CONSTRAINTS if reach else MELON_CONSTRAINTS
+    config = melon_config(
+        duration=2.0, steps=4, optimize_durations=optimize_durations, constraints=constraints
+    )
+    body = rigid_body_from_robot(load_robot("anymal_c")) if reach else TOWR_ANYMAL
+    terrain = TerrainModel(
+        load_terrain("single_pallet"), config.terrain, config.costs.step_edge_sigma
+    )
+    return Formulation(config, body, make_gait("walk", 4, 2.0), terrain), body, terrain
+
+
 @pytest.mark.parametrize(
     ("optimize_durations", "reach"), [(False, False), (True, False), (False, True), (True, True)]
 )
@@ -256,15 +272,7 @@ def test_hessian_equals_casadis_of_the_whole_lagrangian(
     # with optimised durations their inputs are not affine and the points'
     # curvature is added. Both must equal CasADi's Hessian of the Lagrangian
     # as one MX expression, terrain splines included.
-    constraints = MELON_REACH_CONSTRAINTS if reach else MELON_CONSTRAINTS
-    config = melon_config(
-        duration=2.0, steps=4, optimize_durations=optimize_durations, constraints=constraints
-    )
-    body = rigid_body_from_robot(load_robot("anymal_c")) if reach else TOWR_ANYMAL
-    terrain = TerrainModel(
-        load_terrain("single_pallet"), config.terrain, config.costs.step_edge_sigma
-    )
-    nlp = Formulation(config, body, make_gait("walk", 4, 2.0), terrain)
+    nlp, body, terrain = _pallet_walk(optimize_durations, reach)
     called = {rows.name for rows in nlp.rows if rows.calls}
     assert {"dynamics", "range_of_motion"} <= called
     assert ("leg_reach" in called) == reach
@@ -294,15 +302,7 @@ def test_jacobian_equals_casadis_of_the_whole_constraints(
     # With fixed durations the rows made of calls are differentiated as
     # blockdiag(∂F/∂u)·A and projected onto the rows' sparsity; IPOPT must see
     # the structure and values of CasADi's Jacobian of g as one MX expression.
-    constraints = MELON_REACH_CONSTRAINTS if reach else MELON_CONSTRAINTS
-    config = melon_config(
-        duration=2.0, steps=4, optimize_durations=optimize_durations, constraints=constraints
-    )
-    body = rigid_body_from_robot(load_robot("anymal_c")) if reach else TOWR_ANYMAL
-    terrain = TerrainModel(
-        load_terrain("single_pallet"), config.terrain, config.costs.step_edge_sigma
-    )
-    nlp = Formulation(config, body, make_gait("walk", 4, 2.0), terrain)
+    nlp, body, terrain = _pallet_walk(optimize_durations, reach)
     task = resolve(Task((0.55, 0.0, 0.0), (0.95, 0.05, 0.1)), body, terrain)
     rng = np.random.default_rng(5)
     x = HeuristicInitializer().guess(nlp, task) + 0.01 * rng.normal(size=nlp.n_variables)

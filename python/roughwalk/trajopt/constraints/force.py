@@ -21,7 +21,7 @@ from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_rows
 if TYPE_CHECKING:
     from roughwalk.trajopt.formulation import Formulation
 
-__all__ = ["ForceLimits", "terrain_basis"]
+__all__ = ["ForceLimits", "force_limit_rows", "terrain_basis"]
 
 
 def terrain_basis(terrain_values: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX]:
@@ -31,6 +31,20 @@ def terrain_basis(terrain_values: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX]:
     t1 = ca.vertcat(1.0, 0.0, hx)
     t2 = ca.vertcat(0.0, 1.0, hy)
     return n / ca.norm_2(n), t1 / ca.norm_2(t1), t2 / ca.norm_2(t2)
+
+
+def force_limit_rows(
+    f: ca.SX, basis: tuple[ca.SX, ca.SX, ca.SX], mu: float, f_max: float
+) -> list[tuple[ca.SX, float, float]]:
+    """The five (row, lower, upper) of one force ``f``: 0 ≤ f·n ≤ f_max and the friction pyramid."""
+    n, t1, t2 = basis
+    return [
+        (ca.dot(f, n), 0.0, f_max),
+        (ca.dot(f, t1 - mu * n), -np.inf, 0.0),
+        (ca.dot(f, t1 + mu * n), 0.0, np.inf),
+        (ca.dot(f, t2 - mu * n), -np.inf, 0.0),
+        (ca.dot(f, t2 + mu * n), 0.0, np.inf),
+    ]
 
 
 @register("force")
@@ -46,10 +60,5 @@ class ForceLimits(Constraint):
             for phase in nlp.stance_phases(foot):
                 n, t1, t2 = terrain_basis(nlp.foothold_terrain(foot, phase))
                 for node in force.free_nodes(phase):
-                    f = force.node_pos[node]
-                    parts.append((ca.dot(f, n), 0.0, f_max))
-                    parts.append((ca.dot(f, t1 - mu * n), -np.inf, 0.0))
-                    parts.append((ca.dot(f, t1 + mu * n), 0.0, np.inf))
-                    parts.append((ca.dot(f, t2 - mu * n), -np.inf, 0.0))
-                    parts.append((ca.dot(f, t2 + mu * n), 0.0, np.inf))
+                    parts += force_limit_rows(force.node_pos[node], (n, t1, t2), mu, f_max)
         return stack_rows(self.name, parts)

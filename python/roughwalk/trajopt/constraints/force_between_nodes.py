@@ -36,10 +36,9 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import casadi as ca
-import numpy as np
 
 from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_rows
-from roughwalk.trajopt.constraints.force import terrain_basis
+from roughwalk.trajopt.constraints.force import force_limit_rows, terrain_basis
 
 if TYPE_CHECKING:
     from roughwalk.trajopt.formulation import Formulation
@@ -65,7 +64,7 @@ class ForceBetweenNodes(Constraint):
         parts = []
         for foot, force in enumerate(nlp.forces):
             for phase in nlp.stance_phases(foot):
-                n, t1, t2 = terrain_basis(nlp.foothold_terrain(foot, phase))
+                basis = terrain_basis(nlp.foothold_terrain(foot, phase))
                 nodes = force.phase_nodes(phase)
                 for k in nodes[:-1]:
                     points = inner_control_points(
@@ -76,9 +75,5 @@ class ForceBetweenNodes(Constraint):
                         force.spline.durations[k],
                     )
                     for f in points:
-                        parts.append((ca.dot(f, n), 0.0, f_max))
-                        parts.append((ca.dot(f, t1 - mu * n), -np.inf, 0.0))
-                        parts.append((ca.dot(f, t1 + mu * n), 0.0, np.inf))
-                        parts.append((ca.dot(f, t2 - mu * n), -np.inf, 0.0))
-                        parts.append((ca.dot(f, t2 + mu * n), 0.0, np.inf))
+                        parts += force_limit_rows(f, basis, mu, f_max)
         return stack_rows(self.name, parts)
