@@ -370,6 +370,11 @@ def main() -> None:
             f"targets ({best}): median solve {b['median_solve_s']:.3f} s wall, "
             + (f"{cpu:.3f} s CPU (≤ 0.25), " if cpu is not None else "CPU untimed, ")
             + f"iterations {ratio:.1f}× fewer (≥ 4), beyond g_max {b['beyond_g_max']:.1%} (≤ 1 %)"
+            + (
+                ""
+                if b["beyond_task_g_max"] is None
+                else f", beyond the task's g_max {b['beyond_task_g_max']:.1%} (≤ 1 %)"
+            )
         )
     if table:
         print("Table I (heuristic guess, medians over tasks):")

@@ -11,7 +11,7 @@ import pytest
 from roughwalk.errors import ConfigError, InvalidArgumentError
 from roughwalk.learning import Dataset, ProblemSpec, TaskSpace, generate
 from roughwalk.learning.dataset import COLUMNS
-from roughwalk.learning.experience import read_run
+from roughwalk.learning.experience import jittered, read_run
 
 SPEC = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0)
 SPACE = TaskSpace("flat_small", "flat", (-0.1, -0.1, -0.2), (0.1, 0.1, 0.2), (0.4, 0.0, 0.0))
@@ -190,3 +190,17 @@ def test_best_per_task_keeps_each_task_s_feasible_cheapest_solve() -> None:
     # Task 0: cheaper first; 1: cheaper second; 2: the feasible one, dearer; 3: only first.
     assert merged["x"][:, 0].tolist() == [1.0, 2.0, 2.0, 1.0]
     assert merged["cost"].tolist() == [1.0, 1.0, 9.0, 4.0]
+
+
+def test_jittered_starts_depend_on_seed_and_index_only() -> None:
+    tasks = SPACE.sample(4)
+    moved = jittered(tasks, [0, 1, 2, 3], (0.1, 0.1, 0.2), seed=5)
+    # Resumed with the first two done, the rest are asked the same.
+    assert jittered(tasks[2:], [2, 3], (0.1, 0.1, 0.2), seed=5) == moved[2:]
+    assert jittered(tasks, [0, 1, 2, 3], (0.1, 0.1, 0.2), seed=6) != moved
+    for task, new in zip(tasks, moved, strict=True):
+        assert new.goal == task.goal and new.start != task.start
+        assert np.all(np.abs(np.subtract(new.start, task.start)) < 5 * np.array([0.1, 0.1, 0.2]))
+    assert jittered(tasks, [0, 1, 2, 3], (0.0, 0.0, 0.0), seed=5) == tasks
+    with pytest.raises(ConfigError, match="three standard deviations"):
+        jittered(tasks, [0, 1, 2, 3], (0.1, 0.1), seed=5)

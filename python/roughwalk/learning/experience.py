@@ -46,6 +46,7 @@ __all__ = [
     "solve_job",
     "ExperienceRun",
     "generate",
+    "jittered",
     "result_row",
     "read_run",
 ]
@@ -251,6 +252,8 @@ def generate(
     progress: TextIO | None = sys.stderr,
     on_solved: Callable[[dict[str, Any]], None] | None = None,
     indices: Sequence[int] | None = None,
+    jitter: Sequence[float] | None = None,
+    jitter_seed: int = 0,
 ) -> Dataset:
     """Solve tasks 0..n_tasks−1 of ``space``'s ``split`` into ``folder``; resume what is there.
 
@@ -279,6 +282,10 @@ def generate(
         Called with each stored row (tests interrupt a run with it).
     indices:
         Solve these task indices instead of 0..n_tasks−1.
+    jitter, jitter_seed:
+        With a model: ask it for the guess of a task whose start is moved
+        by these standard deviations (x [m], y [m], yaw [rad]); see
+        :func:`jittered`. Recorded in the run.
 
     Returns
     -------
@@ -305,6 +312,8 @@ def generate(
             # The guesses' source by content: a retrained model keeps its name.
             "model": None if model is None else model.fingerprint,
             "max_iter": max_iter,
+            # Only when given: runs made before jitter existed resume as before.
+            **({} if jitter is None else {"jitter": [*map(float, jitter), int(jitter_seed)]}),
         },
     )
     wanted = list(range(n_tasks)) if indices is None else sorted(set(indices))
@@ -313,8 +322,9 @@ def generate(
     tasks = [space.task(i, seed=seed, split=split) for i in todo]
     jobs = [SolveJob(spec, i, t, max_iter) for i, t in zip(todo, tasks, strict=True)]
     if model is not None and tasks:
-        x0s = model.predict_tasks(tasks)
-        lam_x, lam_g = model.predict_multipliers(tasks)
+        asked = tasks if jitter is None else jittered(tasks, todo, jitter, jitter_seed)
+        x0s = model.predict_tasks(asked)
+        lam_x, lam_g = model.predict_multipliers(asked)
         jobs = [
             SolveJob(
                 spec,
@@ -344,6 +354,28 @@ def generate(
         run._write_meta()
     run.meta["layout"] = [list(item) for item in run.meta["layout"]]
     return run.dataset(wanted)
+
+
+def jittered(
+    tasks: Sequence[Task], indices: Sequence[int], jitter: Sequence[float], seed: int
+) -> list[Task]:
+    """``tasks`` with each start moved by N(0, diag(jitter)²), drawn from (seed, index).
+
+    A learned guess asked for a nearby task lands in another basin of the
+    NLP: re-solving the same task from jittered guesses is a multi-start
+    that finds the lower minima a model trained on single solves misses
+    (far starts on the single pallet). The draw depends only on the seed
+    and the task's index, so a resumed or distributed run asks the same.
+    """
+    sigma = np.asarray(jitter, dtype=float)
+    if sigma.shape != (3,) or np.any(sigma < 0):
+        raise ConfigError(f"jitter is three standard deviations (x, y, yaw) >= 0, got {jitter!r}")
+    out = []
+    for task, index in zip(tasks, indices, strict=True):
+        shift = np.random.default_rng([seed, int(index)]).normal(0.0, 1.0, 3) * sigma
+        start = tuple(float(v) for v in np.asarray(task.start, dtype=float) + shift)
+        out.append(Task(start, task.goal))  # type: ignore[arg-type]
+    return out
 
 
 def read_run(folder: str | Path) -> Dataset:
