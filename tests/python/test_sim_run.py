@@ -69,6 +69,16 @@ def test_littledog_walks_half_a_metre_on_flat_ground(littledog) -> None:
     walking = np.asarray(log["mode"]) == 0
     err = np.linalg.norm(log["base_pos"] - log["base_pos_desired"], axis=1)[walking]
     assert np.nanmax(err) < 0.01
+    # The clock splits into shifts and swings, one footstep per step walked,
+    # each foot carried forward by the plan's stride.
+    split = result.outcome.extra["time_breakdown"]
+    assert split["total_s"] == pytest.approx(result.outcome.time_s, abs=0.01)
+    assert split["shift_s"] > 0 and split["swing_s"] > 0
+    assert split["wait_s"] == 0 and split["reflex_s"] < 0.01
+    assert split["footsteps"] == len(log.meta["footstep_times"])
+    assert abs(split["footsteps"] - result.outcome.steps) <= 1
+    assert 0.03 < split["mean_stride_m"] < 0.13
+    assert split["mean_advance_m"] == pytest.approx(split["mean_stride_m"] / 4, rel=0.25)
 
 
 @pytest.mark.skipif(not HAVE_PLANNER, reason="the compiled core has no FootstepPlanner")
@@ -92,6 +102,8 @@ def test_a_push_beyond_the_threshold_triggers_a_reflex_and_a_replan(littledog) -
     assert events.index("push") < first_reflex < events.index("replan")
     assert "recovery" in events[first_reflex:]
     assert_walked_to_goal(result)
+    # The recovery and the re-plan's stand are the reflex's share of the clock.
+    assert result.outcome.extra["time_breakdown"]["reflex_s"] > 0.2
     # Without reflexes the same push is not noticed: no re-plan.
     blind = walk(
         littledog,
