@@ -249,6 +249,7 @@ def test_cli_run_writes_json_report_and_replays(tmp_path: Path) -> None:
     assert doc["speed_cm_s"] > 0 and doc["reflexes"] == 0 and doc["replans"] == 0
     page = (out / "index.html").read_text()
     assert "path.png" in page and "tracking.png" in page and "Reached the goal" in page
+    assert doc["extra"]["time_breakdown"]["swing_s"] > 0 and "where the time went" in page
     assert main(["run", "--terrain", "flat", "--start", "0,0", "--goal", "x,1"]) == 1
     from roughwalk.sim.video import gl_backend
 
@@ -289,3 +290,42 @@ def test_plan_expansions_setting_makes_the_planner_stop_at_its_budget(littledog)
     assert first.footsteps == again.footsteps
     with pytest.raises(roughwalk.ConfigError, match="plan_expansions"):
         roughwalk.sim.sim_config(**{"executor.plan_expansions": -1})
+
+
+@pytest.mark.skipif(not HAVE_PLANNER, reason="the compiled core predates the footstep planner")
+def test_longest_step_setting_lengthens_the_planned_strides(littledog) -> None:
+    # executor.longest_step (opt-in): forward actions of that many hip-to-hip
+    # lengths; a steady crawl's stride is 1.6 times the longest action.
+    terrain = roughwalk.load_terrain("flat")
+
+    def planned(**extra: object) -> tuple[int, float]:
+        result = run(
+            littledog,
+            terrain,
+            (0.25, 0.0, 0.0),
+            (1.25, 0.0),
+            planner="planner",
+            **{
+                "executor.compute_time_scale": 0.0,
+                "executor.plan_expansions": 3000,
+                "outcome.time_limit_s": 0.2,
+                **extra,
+            },
+        )
+        plan = result.plans[0]
+        last: dict[str, np.ndarray] = {}
+        strides = []
+        for f in plan.footsteps:
+            xy = np.array([f.x, f.y])
+            if f.leg in last:
+                strides.append(float(np.linalg.norm(xy - last[f.leg])))
+            last[f.leg] = xy
+        return plan.steps, float(np.median(strides))
+
+    steps, stride = planned()
+    longer_steps, longer_stride = planned(**{"executor.longest_step": 0.375})
+    assert stride == pytest.approx(1.6 * 0.3 * 0.202, abs=0.01)
+    assert longer_stride > stride + 0.015
+    assert longer_steps < steps
+    with pytest.raises(roughwalk.ConfigError, match="longest_step"):
+        planned(**{"executor.longest_step": -0.1})
