@@ -112,6 +112,19 @@ class TimingConfig:
         4.4 s), so it stays 0.
     min_swing_s:
         Shortest swing phase [s].
+    swing_trunk:
+        The trunk under which the swing's joint speeds are estimated:
+        ``"still"`` (default) holds the swing pose throughout; ``"landing"``
+        carries its height and tilt on to the landing certificate's, as the
+        initial trajectory does; ``"shorter"``: the shorter of the two.
+        Stepping down from the barrier (8 cm), the swing pose leaves the
+        landing foot at the edge of its reach, where the knee's rate per
+        metre soars: "still" timed that swing 1.12 s, "landing" 0.64 s (both
+        valid); stepping over it, "landing" lowers the trunk while the foot
+        is at its highest and timed 1.4 s against 0.7 s. Either estimate is
+        only the first guess: the initial trajectory's measured swing
+        (``_retimed``) lengthens any step whose joints would outrun their
+        limits, and never shortens one, hence "shorter".
     max_step_s:
         Longest a step may be made by restarts [s].
     settle_s:
@@ -128,6 +141,7 @@ class TimingConfig:
     min_swing_s: float = 0.3
     max_step_s: float = 4.0
     settle_s: float = 0.8
+    swing_trunk: str = "still"
 
     def shift_floor(self, travel: float) -> float:
         """Shortest shift phase [s] for a ZMP travel of ``travel`` [m]."""
@@ -145,6 +159,11 @@ class TimingConfig:
             v = getattr(self, name)
             if not (math.isfinite(v) and v >= 1):
                 raise ConfigError(f"timing.{name} must be ≥ 1, got {v}")
+        if self.swing_trunk not in ("still", "landing", "shorter"):
+            raise ConfigError(
+                "timing.swing_trunk must be 'still', 'landing' or 'shorter', "
+                f"got {self.swing_trunk!r}"
+            )
 
 
 @dataclass(frozen=True)
