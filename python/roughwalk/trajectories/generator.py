@@ -504,7 +504,8 @@ class FootstepTrajectoryGenerator:
     ) -> tuple[FootstepState, float]:
         """The initial trajectory of step k, lengthened until its swing keeps the velocity limits.
 
-        The nominal timing (§5.2) sees the swing leg under a still trunk; the
+        The nominal timing (§5.2) sees the swing leg under a still trunk (or
+        one that only changes height and tilt, ``timing.swing_trunk``); the
         preview controller moves the trunk during the swing, and the swing leg
         can then outrun a joint's limit by up to ~20 % (LittleDog boards A, C,
         Y). CHOMP's joint-speed term rarely recovers that, and the restart
