@@ -105,7 +105,10 @@ def stands_where_put(result: Any) -> bool:
     """
     if result.outcome.reason.startswith("no plan: start stance"):
         return False
-    first = result.to_dict().get("first_motion_s")
+    # The outcome's extra fields, not the flat JSON (read from there, the
+    # first motion was always None, and every run that fell anywhere was
+    # taken for a start that did not hold and walked again from a nudged start).
+    first = result.outcome.extra.get("first_motion_s")
     for event in result.log.events:
         if event["kind"] == "fall" and (first is None or event["time"] <= first + PLACEMENT_S):
             return False
@@ -145,7 +148,9 @@ def one_run(
     probe_plan_s = plan_time if int(sim.get("executor.plan_expansions", 0) or 0) else 0.5
     began = time.perf_counter()
     result = None
+    tried = 0
     for dx, dy in START_NUDGES:
+        tried += 1
         where = (start[0] + dx, start[1] + dy, start[2])
         # Put the robot down and let it settle: a short run up to the first step.
         probe = run(
@@ -184,6 +189,7 @@ def one_run(
         )
     out = result.to_dict()
     out["wall_s"] = time.perf_counter() - began
+    out["starts_tried"] = tried
     out["rescued"] = bool(out["success"] and out["reflexes"] > 0)
     return out
 

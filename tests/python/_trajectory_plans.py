@@ -92,3 +92,48 @@ def low_swing_config(**more: Any) -> dict[str, Any]:
 def unit(v: np.ndarray) -> np.ndarray:
     """v / ‖v‖."""
     return v / np.linalg.norm(v)
+
+
+def step_down_plan(
+    robot: rw.Robot, terrain: rw.Terrain, wb: WholeBody, *, stride: float = 0.08
+) -> dict[str, Any]:
+    """LF steps ``stride`` [m] down from the top of an 8 cm block centred at x = 1 m.
+
+    ``terrain``: ``barrier:height=0.08,thickness=0.06,center=1.0``. RF stands
+    behind the block, the hind feet on the ground; the trunk 2 cm below the
+    nominal stance fitted to the feet, before and after.
+    """
+    r = robot.foot_radius
+    feet = robot.nominal_stance.feet.copy()
+    feet[:, 0] += 1.0 - feet[0, 0]
+    feet[1, 0] -= 0.07
+    feet[:, 2] = r
+    feet[0, 2] = 0.08 + r
+    target = feet[0].copy()
+    target[0] += stride
+    target[2] = r
+    base, rpy = nominal_fit(wb, feet)
+    base[2] -= 0.02
+    after = feet.copy()
+    after[0] = target
+    end_base, end_rpy = nominal_fit(wb, after)
+    end_base[2] -= 0.02
+    end = pose_over_support(wb, after, [0, 1, 2, 3], 0.015, start=(end_base, end_rpy))
+    return {
+        "robot": robot.name,
+        "terrain": terrain.spec,
+        "footsteps": [
+            {"leg": name, "x": float(f[0]), "y": float(f[1]), "z": float(f[2] - r)}
+            for name, f in zip(LEG_NAMES, feet, strict=True)
+        ]
+        + [{"leg": "LF", "x": float(target[0]), "y": float(target[1]), "z": 0.0}],
+        "initial_pose": {"base_pos": base.tolist(), "base_quat": rpy_to_quat(rpy).tolist()},
+        "certificates": [
+            {
+                "step": 1,
+                "base_pos": end.base_pos.tolist(),
+                "base_quat": end.base_quat.tolist(),
+                "q": robot.from_canonical(end.q.reshape(12)).tolist(),
+            }
+        ],
+    }

@@ -69,6 +69,16 @@ def test_littledog_walks_half_a_metre_on_flat_ground(littledog) -> None:
     walking = np.asarray(log["mode"]) == 0
     err = np.linalg.norm(log["base_pos"] - log["base_pos_desired"], axis=1)[walking]
     assert np.nanmax(err) < 0.01
+    # The clock splits into shifts and swings, one footstep per step walked,
+    # each foot carried forward by the plan's stride.
+    split = result.outcome.extra["time_breakdown"]
+    assert split["total_s"] == pytest.approx(result.outcome.time_s, abs=0.01)
+    assert split["shift_s"] > 0 and split["swing_s"] > 0
+    assert split["wait_s"] == 0 and split["reflex_s"] < 0.01
+    assert split["footsteps"] == len(log.meta["footstep_times"])
+    assert abs(split["footsteps"] - result.outcome.steps) <= 1
+    assert 0.03 < split["mean_stride_m"] < 0.13
+    assert split["mean_advance_m"] == pytest.approx(split["mean_stride_m"] / 4, rel=0.25)
 
 
 @pytest.mark.skipif(not HAVE_PLANNER, reason="the compiled core has no FootstepPlanner")
@@ -92,6 +102,8 @@ def test_a_push_beyond_the_threshold_triggers_a_reflex_and_a_replan(littledog) -
     assert events.index("push") < first_reflex < events.index("replan")
     assert "recovery" in events[first_reflex:]
     assert_walked_to_goal(result)
+    # The recovery and the re-plan's stand are the reflex's share of the clock.
+    assert result.outcome.extra["time_breakdown"]["reflex_s"] > 0.2
     # Without reflexes the same push is not noticed: no re-plan.
     blind = walk(
         littledog,
@@ -237,6 +249,7 @@ def test_cli_run_writes_json_report_and_replays(tmp_path: Path) -> None:
     assert doc["speed_cm_s"] > 0 and doc["reflexes"] == 0 and doc["replans"] == 0
     page = (out / "index.html").read_text()
     assert "path.png" in page and "tracking.png" in page and "Reached the goal" in page
+    assert doc["extra"]["time_breakdown"]["swing_s"] > 0 and "where the time went" in page
     assert main(["run", "--terrain", "flat", "--start", "0,0", "--goal", "x,1"]) == 1
     from roughwalk.sim.video import gl_backend
 
@@ -277,3 +290,42 @@ def test_plan_expansions_setting_makes_the_planner_stop_at_its_budget(littledog)
     assert first.footsteps == again.footsteps
     with pytest.raises(roughwalk.ConfigError, match="plan_expansions"):
         roughwalk.sim.sim_config(**{"executor.plan_expansions": -1})
+
+
+@pytest.mark.skipif(not HAVE_PLANNER, reason="the compiled core predates the footstep planner")
+def test_longest_step_setting_lengthens_the_planned_strides(littledog) -> None:
+    # executor.longest_step (opt-in): forward actions of that many hip-to-hip
+    # lengths; a steady crawl's stride is 1.6 times the longest action.
+    terrain = roughwalk.load_terrain("flat")
+
+    def planned(**extra: object) -> tuple[int, float]:
+        result = run(
+            littledog,
+            terrain,
+            (0.25, 0.0, 0.0),
+            (1.25, 0.0),
+            planner="planner",
+            **{
+                "executor.compute_time_scale": 0.0,
+                "executor.plan_expansions": 3000,
+                "outcome.time_limit_s": 0.2,
+                **extra,
+            },
+        )
+        plan = result.plans[0]
+        last: dict[str, np.ndarray] = {}
+        strides = []
+        for f in plan.footsteps:
+            xy = np.array([f.x, f.y])
+            if f.leg in last:
+                strides.append(float(np.linalg.norm(xy - last[f.leg])))
+            last[f.leg] = xy
+        return plan.steps, float(np.median(strides))
+
+    steps, stride = planned()
+    longer_steps, longer_stride = planned(**{"executor.longest_step": 0.375})
+    assert stride == pytest.approx(1.6 * 0.3 * 0.202, abs=0.01)
+    assert longer_stride > stride + 0.015
+    assert longer_steps < steps
+    with pytest.raises(roughwalk.ConfigError, match="longest_step"):
+        planned(**{"executor.longest_step": -0.1})

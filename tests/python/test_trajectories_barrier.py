@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from _trajectory_plans import BARRIER, barrier_step_plan, low_swing_config
+from _trajectory_plans import BARRIER, barrier_step_plan, low_swing_config, step_down_plan
 from scipy.spatial import cKDTree
 
 import roughwalk as rw
@@ -218,3 +218,29 @@ def test_plan_errors_name_the_problem(robot) -> None:
     }
     with pytest.raises(rw.PlanningError, match="leg 'XX'"):
         rw.footstep_trajectories(bad)
+
+
+def test_swing_timing_under_the_landing_trunk_shortens_a_step_down(robot) -> None:
+    # Stepping down from an 8 cm block, the swing pose leaves the landing foot
+    # at the edge of its reach, where the knee's rate per metre soars; the
+    # trunk the initial trajectory carries down to the landing pose does not.
+    terrain = rw.load_terrain("barrier:height=0.08,thickness=0.06,center=1.0")
+    sdf = terrain.sdf(0.005)
+    plan = step_down_plan(robot, terrain, FootstepTrajectoryGenerator(robot, terrain, sdf=sdf).wb)
+
+    def generator(trunk: str) -> FootstepTrajectoryGenerator:
+        config = rw.trajectories.trajectory_config(**{"timing.swing_trunk": trunk})
+        return FootstepTrajectoryGenerator(robot, terrain, sdf=sdf, config=config)
+
+    still, landing, shorter = (
+        generator(t).prepare(plan).timings[0] for t in ("still", "landing", "shorter")
+    )
+    assert shorter.swing_s == min(still.swing_s, landing.swing_s)
+    assert shorter.swing_s < 0.8 * still.swing_s
+    # The shorter guess is still checked: the step keeps the joints' speed limits.
+    gen = generator("shorter")
+    step = next(gen.iter_steps(gen.prepare(plan)))
+    assert step.report.velocity_limits_ok, step.report.notes
+    assert step.report.swing_s < still.swing_s
+    with pytest.raises(rw.ConfigError, match="swing_trunk"):
+        rw.trajectories.trajectory_config(**{"timing.swing_trunk": "moving"})

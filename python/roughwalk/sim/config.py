@@ -474,14 +474,25 @@ class ExecutorConfig:
         limits the budget reaches first, a run no longer depends on how
         fast the machine is at the moment (the planner's deterministic
         mode).
+    longest_step:
+        The footstep planner's longest forward action, as a fraction of the
+        robot's hip-to-hip length L; 0 keeps the planner's own action set
+        (longest 0.3 L). A value above that adds forward actions of this
+        length (sideways −0.1, 0, 0.1 L). In a steady crawl the stride is
+        1.6 times the longest action (9.6 cm at 0.3 L on LittleDog, whose
+        swings are joint-speed limited at 0.28–0.32 s: longer strides carry
+        the feet farther per swing); ``footstep.max_foot_travel`` (0.6 L)
+        caps it at 0.375 L. Opt-in: see the class table in
+        ``benchmarks/bench_littledog.py``'s results.
     """
 
     compute_time_scale: float = 1.0
     initial_plan_s: float = 10.0
     plan_expansions: int = 0
+    longest_step: float = 0.0
 
     def __post_init__(self) -> None:
-        _nonnegative(self, ("compute_time_scale", "plan_expansions"), "executor")
+        _nonnegative(self, ("compute_time_scale", "plan_expansions", "longest_step"), "executor")
         _positive(self, ("initial_plan_s",), "executor")
 
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator, Sequence
+from dataclasses import asdict
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -40,6 +41,7 @@ from roughwalk.sim.recovery import blend_segment, hold_segment, pose_segment, re
 from roughwalk.sim.reflexes import ReflexMonitor
 from roughwalk.sim.run_log import RunLog
 from roughwalk.sim.runner import Runner
+from roughwalk.sim.time_breakdown import time_breakdown
 from roughwalk.sim.touchdown_adapter import TouchdownAdapter
 from roughwalk.sim.trajectory_buffer import DesiredState, Segment, TrajectoryBuffer
 from roughwalk.sim.world import World
@@ -377,6 +379,11 @@ class Executor:
                 "end_s": end,
             },
         )
+        # Where the clock went (the speed's time: first motion to the goal or the end).
+        clock_start = monitor.first_motion if monitor.first_motion is not None else end
+        breakdown = time_breakdown(log, clock_start, clock_start + outcome.time_s)
+        outcome.extra["time_breakdown"] = breakdown.summary()
+        log.meta["footstep_times"] = [asdict(f) for f in breakdown.footsteps]
         log.event(end, "end", success=outcome.success, reason=outcome.reason)
         log.meta["outcome"] = outcome.to_dict()
         return outcome
@@ -398,6 +405,8 @@ class Executor:
             wall_s=wall,
             ready_at=ready,
             valid=bool(traj.valid),
+            attempts=int(traj.report.attempts),
+            duration_s=float(traj.report.duration_s),
         )
 
     def _next_leg(self, desired: DesiredState) -> int | None:

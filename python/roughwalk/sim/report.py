@@ -110,6 +110,15 @@ def write_report(
     for key in ("start", "goal", "planner"):
         if key in result:
             parts.append(f"<tr><th>{key}</th><td>{html.escape(_fmt(result[key]))}</td></tr>")
+    split = (result.get("extra") or {}).get("time_breakdown")
+    if split and split.get("footsteps"):
+        text = (
+            f"shifts {split['shift_s']:.1f} s, swings {split['swing_s']:.1f} s, "
+            f"settling {split['settle_s']:.1f} s, waits {split['wait_s']:.1f} s, "
+            f"reflexes {split['reflex_s']:.1f} s; {split['footsteps']} footsteps, "
+            f"mean stride {100 * split['mean_stride_m']:.1f} cm"
+        )
+        parts.append(f"<tr><th>where the time went</th><td>{html.escape(text)}</td></tr>")
     disturbances = result.get("disturbances") or []
     if disturbances:
         text = "; ".join(str(x) for x in disturbances)

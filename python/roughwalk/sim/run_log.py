@@ -21,10 +21,15 @@ if TYPE_CHECKING:
     from roughwalk.sim.measured_state import MeasuredState
     from roughwalk.sim.trajectory_buffer import DesiredState
 
-__all__ = ["RunLog", "MODES"]
+__all__ = ["RunLog", "MODES", "OTHER_PHASE"]
 
 MODES = ("walk", "wait", "recovery", "replan", "blend", "done")
 """What the executor was doing, by the code stored in ``mode``."""
+
+OTHER_PHASE = 3
+"""The ``phase`` code of a tick whose desired state is not a footstep's
+(a hold, a blend, a recovery); a footstep's are 0 shift, 1 swing, 2 settle,
+and -1 means no desired state."""
 
 _FIELDS: dict[str, tuple[int, ...]] = {
     "qpos": (-1,),
@@ -74,7 +79,9 @@ class RunLog:
     def __init__(self, meta: dict[str, Any] | None = None) -> None:
         self.meta: dict[str, Any] = dict(meta or {})
         self.events: list[dict[str, Any]] = []
-        self._rows: dict[str, list[Any]] = {k: [] for k in (*_FIELDS, "time", "mode", "step")}
+        self._rows: dict[str, list[Any]] = {
+            k: [] for k in (*_FIELDS, "time", "mode", "step", "phase")
+        }
         self._arrays: dict[str, NDArray[Any]] | None = None
 
     def __len__(self) -> int:
@@ -99,6 +106,11 @@ class RunLog:
         rows["time"].append(np.float64(measured.time))
         rows["mode"].append(np.int8(MODES.index(mode)))
         rows["step"].append(np.int16(desired.step if desired is not None else 0))
+        if desired is None:
+            phase = -1
+        else:
+            phase = desired.phase if desired.kind == "step" else OTHER_PHASE
+        rows["phase"].append(np.int8(phase))
         rows["qpos"].append(np.asarray(qpos, dtype=np.float32))
         rows["q"].append(measured.q.astype(np.float32))
         rows["q_command"].append(np.asarray(q_command, dtype=np.float32))

@@ -30,6 +30,7 @@ from roughwalk.trajectories.body_pass import BACKENDS, BodyPass
 from roughwalk.trajectories.chomp import Chomp, ChompStatus
 from roughwalk.trajectories.config import TrajectoryConfig
 from roughwalk.trajectories.costs.obstacle import ObstacleCost
+from roughwalk.trajectories.euler import rpy_to_matrix
 from roughwalk.trajectories.footstep_trajectory import (
     FootstepTrajectory,
     resample_footstep,
@@ -202,24 +203,60 @@ class FootstepTrajectoryGenerator:
                 velocity_limit=self.wb.velocity_limit[step.leg],
             )
             path = spline.position(np.linspace(0.0, 1.0, 41))
-            legs_b = np.repeat(
-                ((pose.feet - pose.base_pos) @ pose.rotation)[None], len(path), axis=0
-            )
-            legs_b[:, step.leg] = (path - pose.base_pos) @ pose.rotation
-            q, _ = self.wb.inverse_kinematics(legs_b)
-            timing = step_timing(
-                shift,
-                q[:, step.leg],
-                self.wb.velocity_limit,
-                self.config.timing,
-                step.leg,
-                settle=k == len(seq.steps) - 1,
-                zmp_travel=None if travels is None else travels[k],
-                from_rest=k == 0,
-            )
+            trunks = {
+                "still": ("still",),
+                "landing": ("landing",),
+                "shorter": ("still", "landing"),
+            }[self.config.timing.swing_trunk]
+            timings = []
+            for trunk in trunks:
+                legs_b = self._swing_legs_in_body(pose, step.end_pose, path, step.leg, trunk)
+                q, _ = self.wb.inverse_kinematics(legs_b)
+                timings.append(
+                    step_timing(
+                        shift,
+                        q[:, step.leg],
+                        self.wb.velocity_limit,
+                        self.config.timing,
+                        step.leg,
+                        settle=k == len(seq.steps) - 1,
+                        zmp_travel=None if travels is None else travels[k],
+                        from_rest=k == 0,
+                    )
+                )
+            timing = min(timings, key=lambda t: t.swing_s)
             out.append(timing.quantized(self.dt))
             previous = pose
         return out
+
+    def _swing_legs_in_body(
+        self,
+        pose: BodyKeyframe,
+        end_pose: BodyKeyframe,
+        path: NDArray[np.float64],
+        leg: int,
+        trunk: str,
+    ) -> NDArray[np.float64]:
+        """The four feet (K, 4, 3) in the trunk frame along a swing foot path (K, 3) [m].
+
+        ``trunk`` "still": the trunk holds the swing pose. "landing": its
+        height and tilt go on to the landing certificate's (``end_pose``) as
+        the initial trajectory's do (a smoothstep over the swing), its x–y
+        held (the ZMP preview moves it less than the certificates differ).
+        The supporting feet's rows are only for the IK.
+        """
+        k = len(path)
+        base = np.repeat(pose.base_pos[None], k, axis=0)
+        rotation = np.repeat(pose.rotation[None], k, axis=0)
+        if trunk == "landing":
+            u = np.linspace(0.0, 1.0, k)
+            u = u * u * (3.0 - 2.0 * u)
+            base[:, 2] += u * (end_pose.base_pos[2] - pose.base_pos[2])
+            turn = (end_pose.rpy - pose.rpy + np.pi) % (2.0 * np.pi) - np.pi
+            rotation = rpy_to_matrix(pose.rpy[None] + u[:, None] * turn[None])
+        feet = np.repeat(pose.feet[None], k, axis=0)
+        feet[:, leg] = path
+        return np.einsum("kfi,kij->kfj", feet - base[:, None, :], rotation)
 
     def zmp_exit(
         self, triangle: NDArray[np.float64], toward: NDArray[np.float64]
@@ -467,7 +504,8 @@ class FootstepTrajectoryGenerator:
     ) -> tuple[FootstepState, float]:
         """The initial trajectory of step k, lengthened until its swing keeps the velocity limits.
 
-        The nominal timing (§5.2) sees the swing leg under a still trunk; the
+        The nominal timing (§5.2) sees the swing leg under a still trunk (or
+        one that only changes height and tilt, ``timing.swing_trunk``); the
         preview controller moves the trunk during the swing, and the swing leg
         can then outrun a joint's limit by up to ~20 % (LittleDog boards A, C,
         Y). CHOMP's joint-speed term rarely recovers that, and the restart
