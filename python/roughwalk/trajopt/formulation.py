@@ -126,7 +126,11 @@ def _call_jacobian(rows: Rows, z: ca.SX, affine: bool) -> ca.SX | None:
 
 
 def _call_hessians(
-    rows: Rows, weights: ca.SX, z: ca.SX, affine: list[tuple[ca.DM, ca.SX]] | None = None
+    rows: Rows,
+    weights: ca.SX,
+    z: ca.SX,
+    affine: list[tuple[ca.DM, ca.SX]] | None = None,
+    curved_points: bool = False,
 ) -> tuple[list[ca.SX], list[tuple[ca.SX, ca.SX]]]:
     """∇²_z (λᵀ g) of rows made of calls g = F(u(z)), by the chain rule.
 
@@ -145,7 +149,9 @@ def _call_hessians(
 
     With a list ``affine``, groups whose points are affine (J constant)
     append (J, D) to it instead of a block: :func:`_merged_product` then
-    forms one product for the calls of all rows.
+    forms one product for the calls of all rows. With ``curved_points``
+    (optimised durations) J is :func:`points_jacobian`, each distinct point
+    differentiated once.
     """
     calls = rows.calls or []
     groups: dict[int, tuple[ca.Function, list[tuple[int, int]]]] = {}
@@ -169,7 +175,7 @@ def _call_hessians(
         h_u, mu = local.map(len(members))(points, row_weights)
         diagonal = ca.diagcat(*ca.horzsplit(h_u, int(flat.numel())))
         u = ca.vec(points)
-        jac = ca.jacobian(u, z)
+        jac = points_jacobian(u, z) if curved_points else ca.jacobian(u, z)
         if jac.is_constant() and affine is not None:
             affine.append((ca.DM(jac), diagonal))
         elif jac.is_constant():
@@ -454,7 +460,9 @@ class Formulation:
         for rows in self.rows:
             weights = lam_g[offset : offset + rows.size]
             if rows.calls is not None:
-                call_blocks, call_curved = _call_hessians(rows, weights, z, affine)
+                call_blocks, call_curved = _call_hessians(
+                    rows, weights, z, affine, self.config.optimize_durations
+                )
                 blocks.extend(call_blocks)
                 curved.extend(call_curved)
             else:
