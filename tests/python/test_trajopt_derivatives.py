@@ -294,13 +294,14 @@ def test_hessian_equals_casadis_of_the_whole_lagrangian(
 
 
 @pytest.mark.parametrize(
-    ("optimize_durations", "reach"), [(False, False), (True, False), (False, True)]
+    ("optimize_durations", "reach"), [(False, False), (True, False), (False, True), (True, True)]
 )
 def test_jacobian_equals_casadis_of_the_whole_constraints(
     optimize_durations: bool, reach: bool
 ) -> None:
-    # With fixed durations the rows made of calls are differentiated as
-    # blockdiag(∂F/∂u)·A and projected onto the rows' sparsity; IPOPT must see
+    # The rows made of calls are differentiated as blockdiag(∂F/∂u)·∂u/∂z
+    # (∂u/∂z = A with fixed durations, each distinct point's own Jacobian with
+    # optimised ones) and projected onto the rows' sparsity; IPOPT must see
     # the structure and values of CasADi's Jacobian of g as one MX expression.
     nlp, body, terrain = _pallet_walk(optimize_durations, reach)
     task = resolve(Task((0.55, 0.0, 0.0), (0.95, 0.05, 0.1)), body, terrain)

@@ -502,7 +502,9 @@ def test_guess_solves_order_with_amd_only_with_the_exact_hessian(tmp_path: Path)
 
 def test_mumps_ordering_follows_durations_and_hessian(tmp_path: Path) -> None:
     fixed = _ipopt_user_options(tmp_path, "fixed", solver__hessian="exact")
-    assert fixed["mumps_pivot_order"] == "7"
+    assert fixed["mumps_pivot_order"] == "0"
+    automatic = _ipopt_user_options(tmp_path, "auto", solver__hessian="limited-memory")
+    assert automatic["mumps_pivot_order"] == "7"
     metis = _ipopt_user_options(
         tmp_path, "metis", solver__hessian="limited-memory", optimize_durations=True
     )

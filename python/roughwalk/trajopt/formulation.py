@@ -29,6 +29,7 @@ from roughwalk.trajopt.constraints import Rows, make_constraint
 from roughwalk.trajopt.costs import CostTerm, make_costs
 from roughwalk.trajopt.gaits import ContactSchedule
 from roughwalk.trajopt.parameters import TrajoptConfig
+from roughwalk.trajopt.point_jacobian import points_jacobian
 from roughwalk.trajopt.robot_model import SingleRigidBody
 from roughwalk.trajopt.task import TASK_SIZE
 from roughwalk.trajopt.terrain_model import TerrainModel
@@ -93,32 +94,43 @@ def _chunk_hessians(expr: ca.SX, weights: ca.SX, z: ca.SX, rows_per_block: int) 
     return blocks
 
 
-def _call_jacobian(rows: Rows, z: ca.SX) -> ca.SX | None:
-    """∂g/∂z of rows made of calls g = F(u) of one function F, when u = A z + b.
+def _call_jacobian(rows: Rows, z: ca.SX, affine: bool) -> ca.SX | None:
+    """∂g/∂z of rows made of calls g = F(u) of one function F, by the chain rule.
 
-    blockdiag(∂F/∂u mapped over the calls) · A, projected onto the rows'
-    own sparsity so that IPOPT sees the same structure as from
-    differentiating the rows: about a third of the CPU of the row blocks'
-    Jacobians. None when the calls mix functions or u is not affine in z
-    (optimised durations), where the row blocks are cheaper.
+    blockdiag(∂F/∂u mapped over the calls) · ∂u/∂z, projected onto the
+    rows' own sparsity so that IPOPT sees the same structure as from
+    differentiating the rows. ∂u/∂z is constant when the points are
+    ``affine`` in z (fixed durations): about a third of the CPU of the row
+    blocks' Jacobians. Otherwise (optimised durations) it is
+    :func:`points_jacobian`, each distinct point differentiated once. None
+    when the calls mix functions or u was expected affine and is not.
     """
     calls = rows.calls or []
     if not calls or any(call.function is not calls[0].function for call in calls):
         return None
     fn = calls[0].function
     points = ca.horzcat(*[ca.vertcat(*[ca.vec(v) for v in call.inputs]) for call in calls])
-    a = ca.jacobian(ca.vec(points), z)
-    if not a.is_constant():
-        return None
+    a: ca.DM | ca.SX
+    if affine:
+        constant = ca.jacobian(ca.vec(points), z)
+        if not constant.is_constant():
+            return None
+        a = ca.DM(constant)
+    else:
+        a = points_jacobian(ca.vec(points), z)
     symbols = [ca.SX.sym(f"u{i}", fn.sparsity_in(i)) for i in range(fn.n_in())]
     flat = ca.vertcat(*[ca.vec(v) for v in symbols])
     local = ca.Function(f"{fn.name()}_jacobian", [flat], [ca.jacobian(ca.vec(fn(*symbols)), flat)])
     diagonal = ca.diagcat(*ca.horzsplit(local.map(len(calls))(points), int(flat.numel())))
-    return ca.project(diagonal @ ca.DM(a), ca.jacobian_sparsity(rows.expr, z))
+    return ca.project(diagonal @ a, ca.jacobian_sparsity(rows.expr, z))
 
 
 def _call_hessians(
-    rows: Rows, weights: ca.SX, z: ca.SX, affine: list[tuple[ca.DM, ca.SX]] | None = None
+    rows: Rows,
+    weights: ca.SX,
+    z: ca.SX,
+    affine: list[tuple[ca.DM, ca.SX]] | None = None,
+    curved_points: bool = False,
 ) -> tuple[list[ca.SX], list[tuple[ca.SX, ca.SX]]]:
     """∇²_z (λᵀ g) of rows made of calls g = F(u(z)), by the chain rule.
 
@@ -137,7 +149,9 @@ def _call_hessians(
 
     With a list ``affine``, groups whose points are affine (J constant)
     append (J, D) to it instead of a block: :func:`_merged_product` then
-    forms one product for the calls of all rows.
+    forms one product for the calls of all rows. With ``curved_points``
+    (optimised durations) J is :func:`points_jacobian`, each distinct point
+    differentiated once.
     """
     calls = rows.calls or []
     groups: dict[int, tuple[ca.Function, list[tuple[int, int]]]] = {}
@@ -161,7 +175,7 @@ def _call_hessians(
         h_u, mu = local.map(len(members))(points, row_weights)
         diagonal = ca.diagcat(*ca.horzsplit(h_u, int(flat.numel())))
         u = ca.vec(points)
-        jac = ca.jacobian(u, z)
+        jac = points_jacobian(u, z) if curved_points else ca.jacobian(u, z)
         if jac.is_constant() and affine is not None:
             affine.append((ca.DM(jac), diagonal))
         elif jac.is_constant():
@@ -364,11 +378,11 @@ class Formulation:
         z = ca.vertcat(self.x, tq)
         nx = self.n_variables
         jac_blocks = []
+        # With optimised durations the points are not affine (the check alone
+        # would cost more than the chain rule through each distinct point).
+        affine = not self.config.optimize_durations
         for rows in self.rows:
-            # With optimised durations the points are not affine (the check alone
-            # would cost more than the row blocks).
-            affine = rows.calls is not None and not self.config.optimize_durations
-            call_jacobian = _call_jacobian(rows, z) if affine else None
+            call_jacobian = _call_jacobian(rows, z, affine) if rows.calls is not None else None
             if call_jacobian is not None:
                 jac_blocks.append(call_jacobian)
                 continue
@@ -446,7 +460,9 @@ class Formulation:
         for rows in self.rows:
             weights = lam_g[offset : offset + rows.size]
             if rows.calls is not None:
-                call_blocks, call_curved = _call_hessians(rows, weights, z, affine)
+                call_blocks, call_curved = _call_hessians(
+                    rows, weights, z, affine, self.config.optimize_durations
+                )
                 blocks.extend(call_blocks)
                 curved.extend(call_curved)
             else:

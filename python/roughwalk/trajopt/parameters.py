@@ -234,14 +234,21 @@ class SolverOptions:
         IPOPT's linear solver ("mumps" ships with CasADi).
     mumps_pivot_order:
         MUMPS's fill-reducing ordering (its ICNTL(7): 0 AMD, 2 AMF, 4 PORD,
-        5 METIS, 6 QAMD, 7 automatic). None picks METIS when phase durations
-        are optimised — their columns are dense, and METIS factorises those
-        KKT systems in about half the time of MUMPS's automatic choice — and
-        the automatic choice otherwise, where no ordering was faster. With
-        optimised durations and the exact Hessian (Melon's costs) it picks
-        AMD: on the single pallet the linear solves took 113 ms an iteration
-        with AMD, 165 with METIS and 242 with the automatic choice (12.1,
-        15.7 and 23.5 s of CPU in all, 107, 95 and 97 iterations).
+        5 METIS, 6 QAMD, 7 automatic). None picks AMD with the exact
+        Hessian (Melon's costs). With optimised durations the linear solves
+        on the single pallet took 113 ms an iteration with AMD, 165 with
+        METIS and 242 with the automatic choice (12.1, 15.7 and 23.5 s of
+        CPU in all, 107, 95 and 97 iterations); with fixed durations, from
+        the heuristic guess, the same iterations and costs took 0.71–0.73 s
+        of CPU against 0.78–0.79 on the single pallet 1.0 m before its edge
+        (41 iterations), 2.80–2.98 against 3.11–3.52 on the double pallet
+        (88), 0.70–0.73 against 0.72–0.73 from 1.5 m before (31); three
+        interleaved pairs, load 10–12. With L-BFGS (TOWR's problems) it
+        picks METIS when phase durations are optimised — their columns are
+        dense, and METIS factorises those KKT systems in about half the time
+        of MUMPS's automatic choice — and the automatic choice otherwise,
+        where no ordering was faster and the ordering changes the
+        iterations (below).
     mumps_scaling:
         Whether MUMPS scales the KKT system's rows and columns (IPOPT's
         ``mumps_scaling`` and ``mumps_permuting_scaling``). None: off with
@@ -279,14 +286,14 @@ class SolverOptions:
         take 1, and on TOWR's cost-free problem (L-BFGS) 12 where
         those take 1: a guess is not a solution. MUMPS's row/column scaling
         is off in them: on 30 held-out tasks the iterations were identical and
-        the CPU time per iteration 13 % lower (interleaved runs). With the
-        exact Hessian and ``mumps_pivot_order`` None their MUMPS ordering is
-        AMD: on 12 held-out single-pallet tasks (fixed durations, same 177
-        iterations) AMD took 21.0–21.6 ms of CPU an iteration against
-        22.2–23.9 for the automatic choice (four interleaved pairs), QAMD
-        22.5, AMF 23.4, PORD 23.5, METIS 33.4. With L-BFGS the ordering
-        changes the iterations: TOWR's walk from its own solution took 18
-        with AMD and 3 with the automatic choice, which it keeps.
+        the CPU time per iteration 13 % lower (interleaved runs). Their MUMPS
+        ordering is ``mumps_pivot_order``'s: on 12 held-out single-pallet
+        tasks (exact Hessian, fixed durations, same 177 iterations) AMD took
+        21.0–21.6 ms of CPU an iteration against 22.2–23.9 for the
+        automatic choice (four interleaved pairs), QAMD 22.5, AMF 23.4,
+        PORD 23.5, METIS 33.4. With L-BFGS the ordering changes the
+        iterations: TOWR's walk from its own solution took 18 with AMD and
+        3 with the automatic choice, which L-BFGS keeps.
 
     Neither set applies to a solve from a guess without multipliers (the
     heuristic's cold solves).
@@ -478,6 +485,25 @@ def towr_config(**changes: object) -> TrajoptConfig:
 
     IPOPT's tolerances are TOWR's (IPOPT's defaults: tol 1e-8, acceptable_tol
     1e-6, constr_viol_tol 1e-4), so that timings compare like with like.
+
+    Compared with TOWR's problem element by element (session 7): the same
+    variables (848 at T = 3.4 s), rows in the same units (N, N·m, m, m/s²),
+    no variable bounds besides TOWR's on the start and goal, IPOPT's options alike (with
+    L-BFGS IPOPT switches both to its adaptive barrier update). Kept on
+    purpose: the start and goal are rows reading the task parameters, not
+    variable bounds, so that one NLP serves every task; TOWR's duplicate
+    rows (each stance's terrain row twice, a second dynamics sample at T)
+    are left out; the initial guess is Melon's heuristic, not TOWR's
+    node-index interpolation (feet straight from start to goal, through a
+    block; m·g/4 on every stance force node). Neither TOWR's guess nor the
+    bounds reduce the iterations over TOWR's tasks: with the goals moved
+    by −0.1 to +0.1 m (5 solves a task, medians) the heuristic with rows
+    took 11 (flat walk), 20 (flat trot), 75 (block 1.5 m), 17 and 43
+    (stairs 1.5 and 1.0 m), 27 (gap trot) and 38 (slope) iterations; TOWR's
+    guess with bounds 14, 17, 26, 26, 34, 56 and 23; either change alone
+    won on some tasks and lost on others. One task's count is a sample of
+    that spread (flat trot 11–29, block 1.5 m 60–106), which holds TOWR's
+    13 and 22–64.
     """
     base = TrajoptConfig(
         constraints=TOWR_CONSTRAINTS,
