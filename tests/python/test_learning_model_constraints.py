@@ -72,3 +72,12 @@ def test_a_spec_without_a_fitting_shipped_model_keeps_its_set() -> None:
     assert spec_for_learned(SPEC) == SPEC
     named = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0, constraints=TOWR_CONSTRAINTS)
     assert spec_for_learned(named) is named
+
+
+def test_the_shipped_double_pallet_model_brings_its_unilateral_rows() -> None:
+    # Trained on solves that do not pull between force nodes (so that the
+    # controller can track them): every double-pallet solve from it keeps them.
+    double = spec_for_learned(ProblemSpec("anymal_c", "double_pallet", "walk", 16, 5.5))
+    assert double.constraints == (*MELON_REACH_CONSTRAINTS, "unilateral_between_nodes")
+    single = ProblemSpec("anymal_c", "single_pallet", "walk", 16, 5.5)
+    assert spec_for_learned(single) == single
