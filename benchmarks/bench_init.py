@@ -61,6 +61,7 @@ from roughwalk.learning import (
     task_space,
 )
 from roughwalk.learning.filtering import cost_threshold, feasible_mask
+from roughwalk.learning.model_constraints import constraints_for_model
 from roughwalk.trajopt import HeuristicInitializer, TrajoptProblem
 
 RESULTS = Path(__file__).resolve().parent / "results"
@@ -121,10 +122,28 @@ def _summary(
     }
 
 
+def _set_suffix(spec: ProblemSpec) -> str:
+    """A run folder's suffix naming a constraint set other than the default ("" for it)."""
+    if spec.constraints is None:
+        return ""
+    default = ProblemSpec().config().constraints
+    extra = [c for c in spec.constraints if c not in default]
+    return "_with_" + "_".join(extra) if extra else "_" + "_".join(spec.constraints)
+
+
+def spec_of_models(env: str, models: list[tuple[str, LearnedModel]]) -> ProblemSpec:
+    """The held-out problem: every initialiser solves the newest model's constraint set."""
+    spec = ProblemSpec("anymal_c", env, "walk", 16, 5.5)
+    if not models:
+        return spec
+    chosen = constraints_for_model(models[-1][1], spec.config().constraints)
+    return spec if chosen == spec.config().constraints else replace(spec, constraints=chosen)
+
+
 def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:
     """Held-out solves from every initialiser, summarised."""
     space = task_space(args.env)
-    base = args.experience / f"{space.name}_{spec.gait}{spec.steps}_test"
+    base = args.experience / f"{space.name}_{spec.gait}{spec.steps}_test{_set_suffix(spec)}"
     runs: dict[str, Dataset] = {}
     runs["Heuristic"] = generate(
         spec, space, args.tasks, base, split="test", max_iter=args.max_iter, progress=None
@@ -314,7 +333,7 @@ def main() -> None:
     )
     parser.add_argument("--json", type=Path, help="output JSON (default results/init_ENV.json)")
     args = parser.parse_args()
-    spec = ProblemSpec("anymal_c", args.env, "walk", 16, 5.5)
+    spec = spec_of_models(args.env, _models(args.models, args.env))
     started = time.perf_counter()
     fig6 = figure_6(args, spec)
     times = timing(args, spec) if args.timing_tasks > 0 else {}

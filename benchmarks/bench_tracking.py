@@ -27,7 +27,7 @@ from __future__ import annotations
 import argparse
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -54,6 +54,8 @@ class Job:
     goal: tuple[float, float, float]
     tracking: tuple[tuple[str, Any], ...] = ()
     """TrackingConfig fields that differ from the default (``--tracking``)."""
+    constraints: tuple[str, ...] | None = None
+    """The NLP's constraint set (None: ``melon_config``'s default)."""
 
 
 def _task_space(env: str) -> tuple[str, list[Any] | None, str]:
@@ -119,6 +121,28 @@ def learned_model_for(env_terrain: str, optimize_durations: bool) -> str:
     return ""
 
 
+def constraints_for(env_terrain: str, optimize_durations: bool) -> tuple[str, ...] | None:
+    """The constraint set of the shipped learned model for this problem (None: the default).
+
+    Every initialiser solves the same NLP on an environment: the one the
+    learned model was trained on (the double pallet's adds
+    ``force_between_nodes``), so that the initialisers compare on one problem.
+    """
+    try:
+        from roughwalk.learning import ProblemSpec
+        from roughwalk.learning.model_constraints import spec_for_learned
+    except ImportError:
+        return None
+    spec = ProblemSpec(
+        terrain=env_terrain,
+        gait=GAIT,
+        steps=STEPS,
+        duration=DURATION,
+        optimize_durations=optimize_durations,
+    )
+    return spec_for_learned(spec).constraints
+
+
 def run_job(job: Job) -> dict[str, Any]:
     """Solve the job's task and execute the result; a plain dict (picklable)."""
     from roughwalk.robots import load_robot
@@ -133,6 +157,8 @@ def run_job(job: Job) -> dict[str, Any]:
     config = melon_config(
         gait=GAIT, steps=STEPS, duration=DURATION, optimize_durations=job.optimize_durations
     )
+    if job.constraints is not None:
+        config = replace(config, constraints=job.constraints)
     row: dict[str, Any] = {
         "env": job.env,
         "init": job.init,
@@ -159,6 +185,7 @@ def run_job(job: Job) -> dict[str, Any]:
         iterations=result.iterations,
         solve_time_s=result.solve_time_s,
         max_violation=result.max_violation if math.isfinite(result.max_violation) else None,
+        constraints=list(result.config.get("constraints", [])),
     )
     if result.splines is None:
         row.update(success=False, reason="no trajectory")
@@ -343,6 +370,7 @@ def main() -> None:
             print(notes[-1])
         for init in inits:
             for opt in durations:
+                constraints = constraints_for(terrain, opt)
                 why = learned_model_for(terrain, opt) if init == "learned" else ""
                 if why:
                     notes.append(f"{env}: learned initialiser skipped ({why})")
@@ -350,7 +378,20 @@ def main() -> None:
                     continue
                 for it in iters:
                     for i, t in enumerate(tasks):
-                        jobs.append(Job(env, terrain, init, it, opt, i, t.start, t.goal, tracking))
+                        jobs.append(
+                            Job(
+                                env,
+                                terrain,
+                                init,
+                                it,
+                                opt,
+                                i,
+                                t.start,
+                                t.goal,
+                                tracking,
+                                constraints,
+                            )
+                        )
     print(f"{len(jobs)} solve-and-execute jobs ...", flush=True)
     executor = _executor(args.executor, args.workers, args.address)
     started = time.perf_counter()

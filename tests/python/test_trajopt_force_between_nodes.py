@@ -134,3 +134,34 @@ def test_rows_add_no_variables(flat: TerrainModel) -> None:
             - nlp.row_slices()["force_between_nodes"].start
             == 10 * config.force_polys_per_stance * stances
         )
+
+
+def test_unilateral_rows_reject_pulling_but_not_sliding(flat: TerrainModel) -> None:
+    # unilateral_between_nodes keeps only 0 ≤ f·n at the inner control points:
+    # two rows a segment; a segment that leaves the friction pyramid passes.
+    config = melon_config(
+        duration=2.0,
+        steps=4,
+        constraints=(*WITH_BETWEEN, "unilateral_between_nodes"),
+    )
+    nlp = Formulation(config, TOWR_ANYMAL, make_gait("walk", 4, 2.0), flat)
+    task = resolve(Task((0.0, 0.0, 0.0), (0.3, 0.0, 0.0)), TOWR_ANYMAL, flat)
+    x, p = HeuristicInitializer().guess(nlp, task), task.vector()
+    rows = nlp.row_slices()
+    assert (
+        rows["unilateral_between_nodes"].stop - rows["unilateral_between_nodes"].start
+        == (rows["force_between_nodes"].stop - rows["force_between_nodes"].start) // 5
+    )
+    force = nlp.forces[0]
+    parts = nlp.split(x)
+    pos, vel = force.unpack(parts[force.name])
+    inner = force.inner_nodes(nlp.stance_phases(0)[1])
+    pos[inner] = [0.0, 0.0, 200.0]
+    vel[inner] = 0.0
+    vel[inner[0], 2] = -8000.0  # dips below zero mid-segment
+    parts[force.name] = force.pack(pos, vel)
+    assert _violation(nlp, nlp.join(parts), p, "unilateral_between_nodes") > 50.0
+    vel[inner[0]] = [8000.0, 0.0, 0.0]  # slides: lateral force far outside the pyramid
+    parts[force.name] = force.pack(pos, vel)
+    assert _violation(nlp, nlp.join(parts), p, "force_between_nodes") > 50.0
+    assert _violation(nlp, nlp.join(parts), p, "unilateral_between_nodes") < 1e-9

@@ -98,8 +98,11 @@ class FixedGuess:
     def multipliers(
         self, nlp: Formulation, task: ResolvedTask
     ) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
-        """The given multipliers (None: IPOPT starts its own)."""
-        return self.lam_x0, self.lam_g0
+        """The given multipliers (None: IPOPT starts its own), lam_g padded for appended rows."""
+        from roughwalk.learning.initializer import _complete_rows
+
+        lam_g = None if self.lam_g0 is None else _complete_rows(nlp, np.asarray(self.lam_g0))
+        return self.lam_x0, lam_g
 
 
 def result_row(index: int, result: TrajoptResult, x0: NDArray[np.float64]) -> dict[str, Any]:

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from roughwalk.errors import ConfigError
+from roughwalk.learning.model_constraints import constraints_for_model
 from roughwalk.learning.model_file import LearnedModel, problem_signature
 from roughwalk.learning.problem_spec import ProblemSpec
 from roughwalk.trajopt import ContactSchedule, Formulation, register_initializer
@@ -114,6 +115,18 @@ class LearnedInitializer:
     def adjust_task(self, task: ResolvedTask) -> ResolvedTask:
         """The task as given."""
         return task
+
+    def constraints(
+        self, requested: tuple[str, ...], signature: dict[str, object]
+    ) -> tuple[str, ...]:
+        """The constraint set to solve with: the model's own unless another was chosen.
+
+        ``signature`` is the problem's (:func:`problem_signature` without the
+        layout), to pick the shipped model; see :mod:`.model_constraints`.
+        """
+        if self.model is None:
+            self.model = _pick(signature)
+        return constraints_for_model(self.model, requested)
 
     def guess(self, nlp: Formulation, task: ResolvedTask) -> NDArray[np.float64]:
         """A_θ(task), within the NLP's variable bounds; refuses a problem the model does not fit."""

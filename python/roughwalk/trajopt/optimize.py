@@ -13,6 +13,7 @@ import hashlib
 import time
 from collections import OrderedDict
 from collections.abc import Callable, Mapping
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -360,6 +361,20 @@ def optimize_motion(
     )
     initializer = make_initializer(cfg.init)
     schedule = initializer.schedule(make_gait(cfg.gait, cfg.steps, cfg.duration))
+    # A learned guess belongs to the constraint set its model was trained on.
+    choose = getattr(initializer, "constraints", None)
+    if callable(choose):
+        signature = {
+            "robot": body.name,
+            "terrain": terrain_model.name,
+            "gait": schedule.name,
+            "steps": schedule.steps,
+            "duration": float(schedule.total_duration),
+            "optimize_durations": bool(cfg.optimize_durations),
+        }
+        chosen = tuple(choose(tuple(cfg.constraints), signature))
+        if chosen != tuple(cfg.constraints):
+            cfg = replace(cfg, constraints=chosen)
     problems = _schedule_problems(schedule, cfg)
     problems += stance_problems(body, terrain_model, the_task.start, "start")
     problems += stance_problems(body, terrain_model, the_task.goal, "goal")

@@ -2,9 +2,12 @@
 
 An initialiser may change the contact schedule (a footstep plan brings its
 own) and the task's start (the plan's first stance), then gives the initial
-variable vector. Other wings add theirs with :func:`register_initializer`;
-the learning wing registers ``learned`` (Melon 2020, §IV) when it is
-imported, since this wing may not import the wings above it.
+variable vector. One with a ``constraints(requested, signature)`` method also
+chooses the constraint set (:func:`~roughwalk.trajopt.optimize_motion` asks
+it): a learned model's guess belongs to the set it was trained on. Other
+wings add theirs with :func:`register_initializer`; the learning wing
+registers ``learned`` (Melon 2020, §IV) when it is imported, since this wing
+may not import the wings above it.
 """
 
 from __future__ import annotations
