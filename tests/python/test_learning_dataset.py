@@ -204,3 +204,29 @@ def test_jittered_starts_depend_on_seed_and_index_only() -> None:
     assert jittered(tasks, [0, 1, 2, 3], (0.0, 0.0, 0.0), seed=5) == tasks
     with pytest.raises(ConfigError, match="three standard deviations"):
         jittered(tasks, [0, 1, 2, 3], (0.1, 0.1), seed=5)
+
+
+def test_generate_cli_selects_far_starts_and_checks_jitter(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--start-x-max`` solves only the far starts; ``--jitter`` needs a model and 3 numbers."""
+    from roughwalk.cli.main import main
+    from roughwalk.learning.task_space import ENVIRONMENTS
+
+    common = ["init", "generate", "--env", "flat", "--steps", "4", "--duration", "2.0"]
+    starts = [ENVIRONMENTS["flat"].task(i).start[0] for i in range(6)]
+    x_max = float(np.median(starts))
+    out = tmp_path / "far"
+    args = [*common, "--tasks", "6", "--max-iter", "0", "--start-x-max", str(x_max)]
+    assert main([*args, "--out", str(out)]) == 0
+    far = [i for i, x in enumerate(starts) if x <= x_max]
+    assert 0 < len(far) < 6
+    assert read_run(out)["index"].tolist() == far
+    capsys.readouterr()
+    for bad, says in (
+        (["--jitter", "0.1,0.1,0.1"], "give --init learned:MODEL"),
+        (["--init", "learned", "--jitter", "0.1,-1,0"], "three numbers >= 0"),
+    ):
+        assert main([*common, "--tasks", "1", "--out", str(tmp_path / "bad"), *bad]) == 1
+        assert says in capsys.readouterr().err
+    assert not (tmp_path / "bad" / "dataset.npz").exists()

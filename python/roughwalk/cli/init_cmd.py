@@ -65,6 +65,18 @@ def register(sub: Any) -> None:
     g.add_argument("--max-iter", type=int, help="IPOPT iterations (default 100, N_h)")
     g.add_argument("--init", default="heuristic", help="heuristic (default) or learned:MODEL")
     g.add_argument("--out", type=Path, help="run folder (default .experience/ENV_GAITSTEPS_SPLIT)")
+    g.add_argument(
+        "--jitter",
+        metavar="SX,SY,SYAW",
+        help="with --init learned:MODEL: ask the model about each task with its start moved "
+        "by these standard deviations (m, m, rad): a multi-start re-solve",
+    )
+    g.add_argument("--jitter-seed", type=int, default=0, help="seed of the jitter draws")
+    g.add_argument(
+        "--start-x-max",
+        type=float,
+        help="solve only the tasks (of the first --tasks) whose start x is at most this (m)",
+    )
     g.set_defaults(func=cmd_generate)
 
     t = s.add_parser("train", help="filter a dataset and fit the learned initialiser")
@@ -125,6 +137,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         None if args.constraints is None else constraint_set(args.constraints),
     )
     out = args.out or DEFAULT_ROOT / f"{space.name}_{args.gait}{args.steps}_{args.split}"
+    jitter = _jitter(args.jitter, args.init != "heuristic")
     model = None
     max_iter = args.max_iter
     if args.init != "heuristic":
@@ -132,8 +145,16 @@ def cmd_generate(args: argparse.Namespace) -> int:
 
         model = model_for_spec(args.init, spec)
         max_iter = 25 if max_iter is None else max_iter
+    indices = None
+    if args.start_x_max is not None:
+        indices = [
+            i
+            for i in range(args.tasks)
+            if space.task(i, seed=args.seed, split=args.split).start[0] <= args.start_x_max
+        ]
     executor = make_executor(args.executor, workers=args.workers, address=args.address)
-    info(f"solving {args.tasks} {args.split} tasks of {space.name} into {out} ...")
+    n = args.tasks if indices is None else len(indices)
+    info(f"solving {n} {args.split} tasks of {space.name} into {out} ...")
     data = generate(
         spec,
         space,
@@ -145,10 +166,32 @@ def cmd_generate(args: argparse.Namespace) -> int:
         model=model,
         init=args.init,
         executor=executor,
+        indices=indices,
+        jitter=jitter,
+        jitter_seed=args.jitter_seed,
     )
     solved = int(sum(s in ("exact", "approximate") for s in data["status"]))
     print(f"{len(data)} tasks in {out / 'dataset.npz'}: {solved} converged")
     return 0
+
+
+def _jitter(text: str | None, learned: bool) -> tuple[float, float, float] | None:
+    """``--jitter SX,SY,SYAW`` as three floats; only meaningful with a learned guess."""
+    from roughwalk.errors import InvalidArgumentError
+
+    if text is None:
+        return None
+    if not learned:
+        raise InvalidArgumentError(
+            "--jitter moves the task a model is asked about: give --init learned:MODEL"
+        )
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(v >= 0.0 for v in values):
+        raise InvalidArgumentError(f"--jitter is SX,SY,SYAW, three numbers >= 0; got {text!r}")
+    return values[0], values[1], values[2]
 
 
 def cmd_train(args: argparse.Namespace) -> int:
