@@ -279,7 +279,18 @@ class WholeBodyQP:
         lb: NDArray[np.float64] | None,
         ub: NDArray[np.float64] | None,
     ) -> tuple[NDArray[np.float64] | None, bool]:
-        """Solve with proxqp directly: qpsolvers cannot set its inner iteration limit."""
+        """Solve with proxqp directly: qpsolvers cannot set its inner iteration limit.
+
+        proxqp's sparse backend, not its dense one: the dense one (its AVX-512
+        build, the one proxsuite loads here) rounds by where its work buffers
+        land in memory, so one QP solved twice gives solutions 1e-10 apart
+        (measured: 60 solves of one tracking tick's QP in one process, two
+        solutions in about equal shares; the sparse backend: one, the same in
+        every process). On a dynamic gait that difference grows, within a few
+        hundred ticks, into a fall in one run and a tracked motion in the next
+        (issue 10). The sparse backend costs about 0.2 ms more per tick.
+        """
+        import scipy.sparse as sp
         from proxsuite import proxqp
 
         n = q.size
@@ -289,7 +300,7 @@ class WholeBodyQP:
             c = np.vstack([g, np.eye(n)[bounded]])
             lower = np.concatenate([lower, lb[bounded]])
             upper = np.concatenate([upper, ub[bounded]])
-        solver = proxqp.dense.QP(n, a_eq.shape[0], c.shape[0])
+        solver = proxqp.sparse.QP(n, a_eq.shape[0], c.shape[0])
         # Tight tolerances: the torques are applied as solved, and a loose
         # equality would be a force error the base feels.
         solver.settings.eps_abs = 1e-8
@@ -297,7 +308,7 @@ class WholeBodyQP:
         solver.settings.max_iter = self.max_iter
         solver.settings.max_iter_in = _PROXQP_MAX_ITER_IN
         solver.settings.verbose = False
-        solver.init(p, q, a_eq, b_eq, c, lower, upper)
+        solver.init(sp.csc_matrix(p), q, sp.csc_matrix(a_eq), b_eq, sp.csc_matrix(c), lower, upper)
         solver.solve()
         status = solver.results.info.status
         x = np.array(solver.results.x, dtype=float)
