@@ -147,7 +147,8 @@ def test_cost_show_writes_picture_and_arrays(tmp_path: Path, capsys) -> None:
     args = ["cost", "show", "--terrain", spec, "-o", str(png), "--npz", str(npz)]
     assert main([*args, "--json", str(js), "--leg", "hind"]) == 0
     assert "shipped default" in capsys.readouterr().out
-    arrays = np.load(npz)
+    with np.load(npz) as archive:  # closed here: a leaked handle warns in a later test
+        arrays = {k: archive[k] for k in archive.files}
     terrain = load_terrain(spec)
     np.testing.assert_array_equal(arrays["x"], terrain.x)
     np.testing.assert_array_equal(arrays["y"], terrain.y)

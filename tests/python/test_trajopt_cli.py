@@ -36,9 +36,9 @@ def test_optimize_writes_json_npz_and_picture(tmp_path: Path, capsys) -> None:
         assert key in data
     # 20 base polynomials: 21 nodes of 12 variables, plus the feet's 20·4 + 108.
     assert data["n_variables"] == 12 * 21 + 20 * 4 + 108
-    samples = np.load(data["trajectory_npz"])
-    np.testing.assert_allclose(samples["com_position"][-1, :2], [0.3, 0.05], atol=1e-4)
-    assert samples["contact"].shape == (len(samples["t"]), 4)
+    with np.load(data["trajectory_npz"]) as samples:
+        np.testing.assert_allclose(samples["com_position"][-1, :2], [0.3, 0.05], atol=1e-4)
+        assert samples["contact"].shape == (len(samples["t"]), 4)
     with Image.open(png) as image:
         assert image.size[0] > 800 and image.size[1] > 500
 

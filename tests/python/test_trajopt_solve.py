@@ -202,9 +202,9 @@ def test_result_json_and_npz(melon: dict[str, TrajoptResult], tmp_path: Path) ->
     assert np.asarray(data["trajectory"]["feet_position"]).shape == (71, 4, 3)
     out = result.to_dict(rate_hz=50.0, npz=tmp_path / "motion.npz")
     assert "trajectory" not in out
-    arrays = np.load(out["trajectory_npz"])
-    np.testing.assert_allclose(arrays["t"][-1], 3.5)
-    np.testing.assert_allclose(np.linalg.norm(arrays["base_quat"], axis=1), 1.0)
+    with np.load(out["trajectory_npz"]) as arrays:
+        np.testing.assert_allclose(arrays["t"][-1], 3.5)
+        np.testing.assert_allclose(np.linalg.norm(arrays["base_quat"], axis=1), 1.0)
 
 
 def test_towr_feasibility_problem_reuses_its_build_and_warm_starts() -> None:

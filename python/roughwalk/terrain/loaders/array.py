@@ -75,6 +75,7 @@ def load_npy(
     except _READ_ERRORS as e:
         raise TerrainError(f"{p}: cannot read as a .npy array ({e})") from None
     if not isinstance(a, np.ndarray):
+        a.close()  # an .npz archive holds its file open
         raise TerrainError(f"{p}: expected a single array, found an archive; name it .npz")
     dx, dy = pair(resolution, "resolution [m]", p, must_be_positive=True)
     x0, y0 = pair(origin, "origin [m]", p)
