@@ -8,9 +8,12 @@ import numpy as np
 import pytest
 
 import roughwalk
-from roughwalk.sim.recovery import recovery_segment
+from roughwalk.sim.recovery import centred_fit, recovery_segment
 from roughwalk.sim.runner import Runner
 from roughwalk.sim.world import World
+from roughwalk.trajectories.body_keyframes import nominal_fit
+from roughwalk.trajectories.euler import rpy_to_quat
+from roughwalk.trajectories.whole_body import WholeBody
 
 
 @pytest.fixture(scope="module")
@@ -58,3 +61,21 @@ def test_a_trunk_heading_for_the_lifted_foot_moves_it_to_the_capture_point(stand
     # Capture off: straight down.
     off = footholds(standing, [0.0, 0.2, 0.0], capture_max_m=0.0)
     np.testing.assert_allclose(off[2, :2], measured.feet[2, :2], atol=1e-12)
+
+
+def test_the_trunk_settles_with_its_centre_of_mass_over_the_feet_on_a_tilted_stance() -> None:
+    robot = roughwalk.load_robot("littledog")
+    st = robot.nominal_stance
+    feet = st.feet + np.array([0.5, 0.0, 0.0])
+    feet[feet[:, 1] < 0, 2] += 0.03  # the right feet 3 cm up a step: a 14° roll
+    pos, rpy = centred_fit(robot, feet)
+    assert abs(rpy[0]) > 0.2
+    quat = rpy_to_quat(rpy)
+    q, reachable = robot.inverse_kinematics(feet, pos, quat)
+    assert reachable.all()
+    com = robot.center_of_mass(q, pos, quat)
+    np.testing.assert_allclose(com[:2], feet[:, :2].mean(axis=0), atol=1e-3)
+    # The plain fit leaves it centimetres towards the low (left) feet.
+    fit_pos, _ = nominal_fit(WholeBody(robot), feet)
+    q, _ = robot.inverse_kinematics(feet, fit_pos, quat)
+    assert robot.center_of_mass(q, fit_pos, quat)[1] - feet[:, 1].mean() > 0.02
