@@ -105,17 +105,9 @@ def learned_available() -> str:
 def learned_model_for(env_terrain: str, optimize_durations: bool) -> str:
     """Why no learned model fits this benchmark's problem on ``env_terrain`` ("" when one does)."""
     try:
-        from roughwalk.learning import ProblemSpec
         from roughwalk.learning.initializer import model_for_spec
 
-        spec = ProblemSpec(
-            terrain=env_terrain,
-            gait=GAIT,
-            steps=STEPS,
-            duration=DURATION,
-            optimize_durations=optimize_durations,
-        )
-        model_for_spec("learned", spec)
+        model_for_spec("learned", _spec(env_terrain, optimize_durations))
     except Exception as e:  # noqa: BLE001  (no model: run without it, and say why)
         return f"{type(e).__name__}: {e}"
     return ""
@@ -126,21 +118,26 @@ def constraints_for(env_terrain: str, optimize_durations: bool) -> tuple[str, ..
 
     Every initialiser solves the same NLP on an environment: the one the
     learned model was trained on (the double pallet's adds
-    ``force_between_nodes``), so that the initialisers compare on one problem.
+    ``unilateral_between_nodes``), so that the initialisers compare on one problem.
     """
     try:
-        from roughwalk.learning import ProblemSpec
         from roughwalk.learning.model_constraints import spec_for_learned
     except ImportError:
         return None
-    spec = ProblemSpec(
+    return spec_for_learned(_spec(env_terrain, optimize_durations)).constraints
+
+
+def _spec(env_terrain: str, optimize_durations: bool) -> Any:
+    """The benchmark's problem on ``env_terrain`` as a learning ProblemSpec."""
+    from roughwalk.learning import ProblemSpec
+
+    return ProblemSpec(
         terrain=env_terrain,
         gait=GAIT,
         steps=STEPS,
         duration=DURATION,
         optimize_durations=optimize_durations,
     )
-    return spec_for_learned(spec).constraints
 
 
 def run_job(job: Job) -> dict[str, Any]:

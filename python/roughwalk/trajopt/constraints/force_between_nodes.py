@@ -41,7 +41,8 @@ of three (520–600 iterations, 18–23 s CPU each).
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from collections.abc import Iterator
+from typing import TYPE_CHECKING, Any
 
 import casadi as ca
 
@@ -51,7 +52,7 @@ from roughwalk.trajopt.constraints.force import force_limit_rows, terrain_basis
 if TYPE_CHECKING:
     from roughwalk.trajopt.formulation import Formulation
 
-__all__ = ["ForceBetweenNodes", "UnilateralBetweenNodes", "inner_control_points"]
+__all__ = ["ForceBetweenNodes", "UnilateralBetweenNodes", "inner_control_points", "stance_segments"]
 
 
 def inner_control_points(
@@ -59,6 +60,24 @@ def inner_control_points(
 ) -> tuple[ca.SX, ca.SX]:
     """Inner Bézier control points of the cubic Hermite segment (f₀, ḟ₀) → (f₁, ḟ₁) of d [s]."""
     return f0 + d * rate0 / 3.0, f1 - d * rate1 / 3.0
+
+
+def stance_segments(nlp: Formulation) -> Iterator[tuple[Any, tuple[Any, Any]]]:
+    """(terrain basis, inner control points) of every stance force segment, feet in order."""
+    for foot, force in enumerate(nlp.forces):
+        for phase in nlp.stance_phases(foot):
+            basis = terrain_basis(nlp.foothold_terrain(foot, phase))
+            for k in force.phase_nodes(phase)[:-1]:
+                yield (
+                    basis,
+                    inner_control_points(
+                        force.node_pos[k],
+                        force.node_vel[k],
+                        force.node_pos[k + 1],
+                        force.node_vel[k + 1],
+                        force.spline.durations[k],
+                    ),
+                )
 
 
 @register("force_between_nodes")
@@ -70,20 +89,9 @@ class ForceBetweenNodes(Constraint):
         mu = nlp.body.friction
         f_max = nlp.body.force_limit
         parts = []
-        for foot, force in enumerate(nlp.forces):
-            for phase in nlp.stance_phases(foot):
-                basis = terrain_basis(nlp.foothold_terrain(foot, phase))
-                nodes = force.phase_nodes(phase)
-                for k in nodes[:-1]:
-                    points = inner_control_points(
-                        force.node_pos[k],
-                        force.node_vel[k],
-                        force.node_pos[k + 1],
-                        force.node_vel[k + 1],
-                        force.spline.durations[k],
-                    )
-                    for f in points:
-                        parts += force_limit_rows(f, basis, mu, f_max)
+        for basis, points in stance_segments(nlp):
+            for f in points:
+                parts += force_limit_rows(f, basis, mu, f_max)
         return stack_rows(self.name, parts)
 
 
@@ -102,17 +110,6 @@ class UnilateralBetweenNodes(Constraint):
     def build(self, nlp: Formulation) -> Rows | None:
         """The normal force [N] at every segment's inner control points, ≥ 0."""
         parts = []
-        for foot, force in enumerate(nlp.forces):
-            for phase in nlp.stance_phases(foot):
-                normal = terrain_basis(nlp.foothold_terrain(foot, phase))[0]
-                nodes = force.phase_nodes(phase)
-                for k in nodes[:-1]:
-                    points = inner_control_points(
-                        force.node_pos[k],
-                        force.node_vel[k],
-                        force.node_pos[k + 1],
-                        force.node_vel[k + 1],
-                        force.spline.durations[k],
-                    )
-                    parts += [(ca.dot(f, normal), 0.0, math.inf) for f in points]
+        for basis, points in stance_segments(nlp):
+            parts += [(ca.dot(f, basis[0]), 0.0, math.inf) for f in points]
         return stack_rows(self.name, parts)
