@@ -22,6 +22,12 @@ depend on its load, so the process CPU time of each solve is recorded too,
 and the cold run's CPU beyond a warm one's as the build CPU ("b. cpu"). Nothing
 is cached on disk: "cold" is a build from scratch.
 
+CPU time is not a fixed cost on a shared machine either: what runs on the
+other core (or hyper-thread) slows this one. In session 8 the same commit's
+flat walk took 0.56–0.99 s cold CPU (build 0.40–0.75 s) from one run to the
+next, and all of session 7's merges measured alike when interleaved (0.56–0.61
+s): compare figures from one run, or interleave the versions compared.
+
 Run: ``python3 benchmarks/bench_trajopt.py [--quick] [--runs N]`` or
 ``roughwalk bench trajopt``. Writes ``benchmarks/results/trajopt.json``.
 """
