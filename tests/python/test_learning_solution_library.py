@@ -17,14 +17,14 @@ from roughwalk.trajopt import Task
 N_X, N_G = 7, 4
 
 
-def _library() -> SolutionLibrary:
+def _library(candidates: int = 1) -> SolutionLibrary:
     # Three tasks; the start yaw varies ten times less than x, so the scaled
     # distance must weigh a yaw difference ten times more.
     goal = [1.6, 0.0, 0.0]
     tasks = [[-0.5, 0.0, 0.0, *goal], [0.5, 0.0, 0.0, *goal], [0.0, 0.0, 0.1, *goal]]
     x = np.arange(3)[:, None] * np.ones(N_X)
     lam_g = 10.0 + np.arange(3)[:, None] * np.ones(N_G)
-    return SolutionLibrary.build(tasks, x, lam_g)
+    return SolutionLibrary.build(tasks, x, lam_g, candidates)
 
 
 def _model(library: SolutionLibrary | None) -> LearnedModel:
@@ -49,7 +49,19 @@ def test_nearest_task_is_found_in_the_spread_scaled_distance() -> None:
     query = [[0.22, 0.0, 0.0, 1.6, 0.0, 0.0], [-0.4, 0.0, 0.0, 1.6, 0.0, 0.0]]
     unscaled = np.argmin(np.linalg.norm(np.array(query)[:, None] - lib.tasks[None], axis=2), 1)
     assert unscaled.tolist() == [2, 0]
-    assert lib.nearest(query).tolist() == [1, 0]
+    assert lib.nearest(query)[:, 0].tolist() == [1, 0]
+    assert lib.nearest(query, 2).tolist() == [[1, 0], [0, 1]]
+
+
+def test_pick_takes_the_candidate_solution_nearest_the_network_s_guess() -> None:
+    """The nearest task's solution may lie in another basin; the guess's is preferred."""
+    task = [[0.45, 0.0, 0.0, 1.6, 0.0, 0.0]]  # nearest task 1, then 0, then 2 (yaw)
+    guess = np.full((1, N_X), 1.8)  # nearest solution: task 2's (all 2)
+    scale = np.ones(N_X)
+    assert _library(1).pick(task, guess, scale).tolist() == [1]
+    assert _library(2).pick(task, guess, scale).tolist() == [1]
+    assert _library(3).pick(task, guess, scale).tolist() == [2]
+    assert _library(2).pick(task, np.full((1, N_X), -0.4), scale).tolist() == [0]
 
 
 def test_library_model_guesses_the_neighbour_s_solution_and_multipliers(tmp_path: Path) -> None:

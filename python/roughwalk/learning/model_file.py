@@ -70,8 +70,9 @@ class LearnedModel:
     library:
         Training solutions (:class:`SolutionLibrary`), or None. With one,
         the guess and the constraint multipliers are the nearest training
-        task's solution and multipliers, the networks' only where the
-        library has none (the bound multipliers).
+        task's solution and multipliers (among the library's candidate
+        tasks, the solution nearest the network's guess), the networks'
+        only where the library has none (the bound multipliers).
 
     """
 
@@ -114,9 +115,19 @@ class LearnedModel:
     def predict_tasks(self, tasks: list[Task]) -> NDArray[np.float64]:
         """Initial guesses (n, n_variables) for ``tasks``."""
         features = task_features(tasks)
+        guesses = np.atleast_2d(self.mlp(features))
         if self.library is not None:
-            return self.library.x[self.library.nearest(features)].astype(float)
-        return np.atleast_2d(self.mlp(features))
+            return self.library.x[self._picked(features, guesses)].astype(float)
+        return guesses
+
+    def _picked(
+        self, features: NDArray[np.float64], guesses: NDArray[np.float64] | None = None
+    ) -> NDArray[np.intp]:
+        """The library rows whose solutions stand in for the network's guesses."""
+        assert self.library is not None
+        if guesses is None:
+            guesses = np.atleast_2d(self.mlp(features))
+        return self.library.pick(features, guesses, self.mlp.out_scale)
 
     def predict_multipliers(
         self, tasks: list[Task]
@@ -124,7 +135,7 @@ class LearnedModel:
         """Predicted (lam_x (n, n_variables), lam_g (n, n_constraints)), or (None, None)."""
         features = task_features(tasks)
         if self.library is not None:
-            lam_g = self.library.lam_g[self.library.nearest(features)].astype(float)
+            lam_g = self.library.lam_g[self._picked(features)].astype(float)
             if self.multiplier_mlp is None:
                 return np.zeros((lam_g.shape[0], self.mlp.n_outputs)), lam_g
             lam_x = np.atleast_2d(self.multiplier_mlp(features))[:, : self.mlp.n_outputs]
@@ -188,7 +199,11 @@ class LearnedModel:
         else:
             header["multipliers"] = None
         if self.library is not None:
-            header["library"] = {"n_solutions": len(self.library), "features": list(FEATURES)}
+            header["library"] = {
+                "n_solutions": len(self.library),
+                "candidates": self.library.candidates,
+                "features": list(FEATURES),
+            }
             arrays.update({f"lib_{k}": v for k, v in self.library.arrays().items()})
         else:
             header["library"] = None
