@@ -8,6 +8,7 @@ heuristic, to the same optimum.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +25,7 @@ from roughwalk.learning import (
     learned_init_rounds,
     train_model,
 )
+from roughwalk.trajopt import Task
 
 SPEC = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0)
 SPACE = TaskSpace("flat_small", "flat", (-0.1, -0.1, -0.2), (0.1, 0.1, 0.2), (0.4, 0.0, 0.0))
@@ -59,6 +61,28 @@ def test_learned_init_converges_in_fewer_iterations_on_held_out_tasks(
                 assert result.solved and result.objective < report.g_max
     heuristic, learned = iterations.values()
     assert np.mean(learned) < np.mean(heuristic), iterations
+
+
+def test_library_model_restarts_a_training_task_from_its_own_solution(
+    experience: Path, tmp_path: Path
+) -> None:
+    from roughwalk.learning.experience import read_run
+
+    data = read_run(experience)
+    model, report = train_model(data, layers=(16, 16), max_epochs=50, library=True)
+    assert model.library is not None and len(model.library) == report.n_good
+    # The task's own solution, not the one of its candidates nearest the network's guess.
+    model.library = replace(model.library, candidates=1)
+    path = model.save(tmp_path / "library.npz")
+    row = int(np.flatnonzero(np.isclose(data["cost"], np.min(data["cost"])))[0])
+    task = (tuple(data["start"][row]), tuple(data["goal"][row]))
+    guess = LearnedModel.load(path).predict(Task(*task))
+    np.testing.assert_allclose(guess, data["x"][row], atol=1e-5)
+    options: dict[str, Any] = {"gait": "walk", "steps": 4, "duration": 2.0, "max_iter": LIMIT}
+    result = roughwalk.optimize_motion("anymal_c", "flat", task, init=f"learned:{path}", **options)
+    # A KKT point with its multipliers: IPOPT's guess options take 2-5 iterations from one.
+    assert result.solved and result.iterations <= 6, result.iterations
+    assert result.objective == pytest.approx(data["cost"][row], rel=1e-3)
 
 
 def test_iteration_rounds_write_models_that_reload(experience: Path, tmp_path: Path) -> None:

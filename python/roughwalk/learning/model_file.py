@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 from roughwalk.errors import ConfigError
 from roughwalk.learning.mlp import MLP
 from roughwalk.learning.problem_spec import ProblemSpec
+from roughwalk.learning.solution_library import SolutionLibrary
 from roughwalk.trajopt import Formulation, Task
 
 __all__ = ["LearnedModel", "MODEL_FORMAT", "MODEL_VERSION", "FEATURES", "task_features"]
@@ -66,13 +67,26 @@ class LearnedModel:
         (lam_x, lam_g) at the solution, or None. IPOPT started from a primal
         guess alone walks the barrier path from its start and gains little
         from a good guess; with multipliers it starts near the path's end.
+    library:
+        Training solutions (:class:`SolutionLibrary`), or None. With one,
+        the guess and the constraint multipliers are the nearest training
+        task's solution and multipliers (among the library's candidate
+        tasks, the solution nearest the network's guess), the networks'
+        only where the library has none (the bound multipliers).
 
     """
 
-    def __init__(self, mlp: MLP, header: dict[str, Any], multipliers: MLP | None = None) -> None:
+    def __init__(
+        self,
+        mlp: MLP,
+        header: dict[str, Any],
+        multipliers: MLP | None = None,
+        library: SolutionLibrary | None = None,
+    ) -> None:
         self.mlp = mlp
         self.header = header
         self.multiplier_mlp = multipliers
+        self.library = library
 
     @property
     def name(self) -> str:
@@ -83,7 +97,9 @@ class LearnedModel:
     def fingerprint(self) -> str:
         """SHA-256 of the networks' arrays: the same for the same weights, whatever the name."""
         digest = hashlib.sha256()
-        nets = [("", self.mlp)] + ([("m_", self.multiplier_mlp)] if self.multiplier_mlp else [])
+        nets: list[tuple[str, MLP | SolutionLibrary]] = [("", self.mlp)]
+        nets += [("m_", self.multiplier_mlp)] if self.multiplier_mlp else []
+        nets += [("lib_", self.library)] if self.library else []
         for prefix, net in nets:
             for key, value in sorted(net.arrays().items()):
                 array = np.ascontiguousarray(value)
@@ -98,15 +114,35 @@ class LearnedModel:
 
     def predict_tasks(self, tasks: list[Task]) -> NDArray[np.float64]:
         """Initial guesses (n, n_variables) for ``tasks``."""
-        return np.atleast_2d(self.mlp(task_features(tasks)))
+        features = task_features(tasks)
+        guesses = np.atleast_2d(self.mlp(features))
+        if self.library is not None:
+            return self.library.x[self._picked(features, guesses)].astype(float)
+        return guesses
+
+    def _picked(
+        self, features: NDArray[np.float64], guesses: NDArray[np.float64] | None = None
+    ) -> NDArray[np.intp]:
+        """The library rows whose solutions stand in for the network's guesses."""
+        assert self.library is not None
+        if guesses is None:
+            guesses = np.atleast_2d(self.mlp(features))
+        return self.library.pick(features, guesses, self.mlp.out_scale)
 
     def predict_multipliers(
         self, tasks: list[Task]
     ) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
         """Predicted (lam_x (n, n_variables), lam_g (n, n_constraints)), or (None, None)."""
+        features = task_features(tasks)
+        if self.library is not None:
+            lam_g = self.library.lam_g[self._picked(features)].astype(float)
+            if self.multiplier_mlp is None:
+                return np.zeros((lam_g.shape[0], self.mlp.n_outputs)), lam_g
+            lam_x = np.atleast_2d(self.multiplier_mlp(features))[:, : self.mlp.n_outputs]
+            return lam_x, lam_g
         if self.multiplier_mlp is None:
             return None, None
-        both = np.atleast_2d(self.multiplier_mlp(task_features(tasks)))
+        both = np.atleast_2d(self.multiplier_mlp(features))
         n_x = int(self.header["multipliers"]["n_lam_x"])
         return both[:, :n_x], both[:, n_x:]
 
@@ -162,6 +198,15 @@ class LearnedModel:
             arrays.update({f"m_{k}": v for k, v in self.multiplier_mlp.arrays().items()})
         else:
             header["multipliers"] = None
+        if self.library is not None:
+            header["library"] = {
+                "n_solutions": len(self.library),
+                "candidates": self.library.candidates,
+                "features": list(FEATURES),
+            }
+            arrays.update({f"lib_{k}": v for k, v in self.library.arrays().items()})
+        else:
+            header["library"] = None
         tmp = target.with_name(target.name + ".part")
         with open(tmp, "wb") as f:
             np.savez_compressed(f, header=np.array(json.dumps(header)), **arrays)
@@ -194,8 +239,16 @@ class LearnedModel:
             m = header["multipliers"]
             own = {k[2:]: v for k, v in arrays.items() if k.startswith("m_")}
             multipliers = MLP.from_arrays(own, m["activation"], int(m["n_layers"]))
+        library = None
+        if header.get("library"):
+            library = SolutionLibrary.from_arrays(
+                {k[4:]: v for k, v in arrays.items() if k.startswith("lib_")}
+            )
         return cls(
-            MLP.from_arrays(arrays, net["activation"], int(net["n_layers"])), header, multipliers
+            MLP.from_arrays(arrays, net["activation"], int(net["n_layers"])),
+            header,
+            multipliers,
+            library,
         )
 
 

@@ -26,6 +26,7 @@ from roughwalk.learning.filtering import best_per_task, filter_good, fit_task_co
 from roughwalk.learning.mlp import MLP
 from roughwalk.learning.model_file import FEATURES, MODEL_FORMAT, MODEL_VERSION, LearnedModel
 from roughwalk.learning.problem_spec import ProblemSpec, build_problem, variable_categories
+from roughwalk.learning.solution_library import SolutionLibrary
 from roughwalk.learning.task_cost_model import TaskCostModel
 
 __all__ = [
@@ -195,6 +196,7 @@ def train_model(
     learned_round: int = 1,
     extra: Mapping[str, Any] | None = None,
     task_cost: TaskCostModel | None | str = "fit",
+    library: bool = False,
 ) -> tuple[LearnedModel, TrainReport]:
     """Filter ``data`` (D_good) and fit A_θ on it.
 
@@ -221,6 +223,10 @@ def train_model(
         fits one on ``data`` when it has enough feasible solutions
         (:func:`~roughwalk.learning.filtering.fit_task_cost`), None uses the
         global threshold.
+    library:
+        Also keep D_good's solutions and constraint multipliers in the model
+        (:class:`~roughwalk.learning.solution_library.SolutionLibrary`): its
+        guess is then the nearest training task's solution.
 
     """
     if "problem" not in data.meta or "layout" not in data.meta:
@@ -299,7 +305,16 @@ def train_model(
         else None,
         **(dict(extra) if extra else {}),
     }
-    return LearnedModel(mlp, header, multiplier_mlp), report
+    kept = _library(good, inputs) if library else None
+    return LearnedModel(mlp, header, multiplier_mlp, kept), report
+
+
+def _library(good: Dataset, inputs: NDArray[np.float64]) -> SolutionLibrary:
+    """D_good's solutions that recorded their constraint multipliers, as a library."""
+    rows = np.all(np.isfinite(good["lam_g"]), axis=1) & (good["lam_g"].shape[1] > 0)
+    if not rows.any():
+        raise InvalidArgumentError("no solution in D_good recorded its multipliers: no library")
+    return SolutionLibrary.build(inputs[rows], good["x"][rows], good["lam_g"][rows])
 
 
 def _task_cost_model(data: Dataset, feasible: NDArray[np.bool_]) -> dict[str, Any] | None:
