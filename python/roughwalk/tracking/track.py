@@ -21,7 +21,7 @@ import numpy as np
 from roughwalk.errors import InvalidArgumentError
 from roughwalk.tracking.config import TrackingConfig
 from roughwalk.tracking.controller import WholeBodyController, rotation_error, tracking_world
-from roughwalk.tracking.outcome import TrackingLog, TrackingOutcome
+from roughwalk.tracking.outcome import TrackingLog, TrackingOutcome, first_leg_contact
 from roughwalk.tracking.reach import LegReach, reach_aware_reference
 from roughwalk.tracking.reference import Reference, load_trajectory
 from roughwalk.tracking.world_terrain import terrain_covering
@@ -267,5 +267,6 @@ def _simulate(
         slips=counts["slip"],
         mean_qp_time_ms=1000.0 * qp_time / max(len(log.t), 1),
         mean_tick_cpu_ms=1000.0 * cpu_time / max(len(log.t), 1),
+        first_leg_contact=first_leg_contact(log),
         log=log,
     )
