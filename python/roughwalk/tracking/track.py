@@ -157,7 +157,14 @@ def _start(world: World, reference: Reference) -> str:
     robot = world.robot
     first = reference(0.0)
     quat = first.base_quat
-    centres = first.feet_pos + np.array([0.0, 0.0, robot.foot_radius])
+    feet = first.feet_pos.copy()
+    # A plan after few solver iterations may start a stance foot centimetres
+    # inside or above the terrain (the learned initialiser's first pose is not
+    # exactly on it): start such feet on the terrain itself, not sunk into it
+    # with the shank or dropping onto it.
+    ground = world.terrain.height(feet[:, :2])
+    feet[first.contact, 2] = ground[first.contact]
+    centres = feet + np.array([0.0, 0.0, robot.foot_radius])
     q, reachable = robot.inverse_kinematics(centres, first.base_pos, quat)
     if not reachable.all():
         return (
