@@ -250,11 +250,14 @@ def test_the_first_pose_puts_planned_stance_feet_on_the_terrain_not_into_or_abov
     ns = robot.nominal_stance
     base = np.array([0.0, 0.0, ns.base_height])
     feet = np.array(ns.feet, dtype=float) + base
-    feet[:, 2] = [-0.04, 0.05, 0.0, 0.0]  # a plan's first stance feet 4 cm under, 5 cm over
+    feet[:, 2] = [-0.04, 0.05, -0.003, 0.0]  # a plan's first stance feet 4 cm under, 5 cm over
     terrain = terrain_covering(load_terrain("flat"), [[0.0, 0.0]])
     world = tracking_world(robot, terrain, TrackingConfig())
     assert _start(world, Reference.standing(base, feet, robot.mass)) == ""
     mujoco.mj_forward(world.model, world.data)
     centres = world.data.geom_xpos[world.roles.foot]
-    np.testing.assert_allclose(centres[:, 2], robot.foot_radius, atol=1e-3)
+    # Centimetres off: on the ground; millimetres off: as planned.
+    np.testing.assert_allclose(
+        centres[:, 2], robot.foot_radius + np.array([0, 0, -0.003, 0]), atol=1e-3
+    )
     np.testing.assert_allclose(centres[:, :2], feet[:, :2], atol=1e-3)

@@ -34,6 +34,9 @@ if TYPE_CHECKING:
 
 __all__ = ["track", "execute_reference", "TrunkPush"]
 
+_START_FOOT_TOLERANCE_M = 0.01
+"""A planned first stance foot farther [m] from the terrain than this starts on it."""
+
 
 @dataclass(frozen=True)
 class TrunkPush:
@@ -161,9 +164,10 @@ def _start(world: World, reference: Reference) -> str:
     # A plan after few solver iterations may start a stance foot centimetres
     # inside or above the terrain (the learned initialiser's first pose is not
     # exactly on it): start such feet on the terrain itself, not sunk into it
-    # with the shank or dropping onto it.
+    # with the shank or dropping onto it. Millimetres off are left as planned.
     ground = world.terrain.height(feet[:, :2])
-    feet[first.contact, 2] = ground[first.contact]
+    off = first.contact & (np.abs(feet[:, 2] - ground) > _START_FOOT_TOLERANCE_M)
+    feet[off, 2] = ground[off]
     centres = feet + np.array([0.0, 0.0, robot.foot_radius])
     q, reachable = robot.inverse_kinematics(centres, first.base_pos, quat)
     if not reachable.all():
