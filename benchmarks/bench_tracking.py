@@ -204,6 +204,7 @@ def run_job(job: Job) -> dict[str, Any]:
         max_orientation_error_rad=_finite(outcome.max_orientation_error_rad),
         fell=outcome.fell,
         tick_cpu_ms=_finite(outcome.mean_tick_cpu_ms),
+        first_leg_contact=outcome.first_leg_contact,
         time_s=time.perf_counter() - started,
         cpu_s=time.process_time() - started_cpu,
     )
@@ -436,8 +437,16 @@ def _progress(row: dict[str, Any]) -> str:
         f"{row['env']} {row['init']} {kind} iters={row['max_iter']} task {row['index']}: "
         f"{row.get('solve_status', '-')} in {row.get('iterations', '-')} iterations; "
         f"{'success' if row.get('success') else 'failure'}: {row.get('reason', '')}"
+        f"{_leg_contact(row.get('first_leg_contact'))}"
         f" ({row.get('cpu_s', 0.0):.0f} s CPU)"
     )
+
+
+def _leg_contact(touch: dict[str, Any] | None) -> str:
+    """'; RF knee touched at 4.66 s (planned stance)' for a run's first leg-link touch."""
+    if not touch:
+        return ""
+    return f"; {touch['leg']} leg link touched at {touch['t']:.2f} s (planned {touch['planned']})"
 
 
 if __name__ == "__main__":

@@ -214,3 +214,50 @@ def test_a_first_pose_out_of_reach_is_a_reported_failure_not_an_exception():
     outcome = execute_reference(reference, robot, load_terrain("flat"))
     assert not outcome.success and outcome.reason.startswith("not started")
     assert outcome.simulated_s == 0.0
+
+
+def test_first_leg_contact_names_the_leg_the_time_and_the_planned_phase():
+    from roughwalk.tracking.outcome import TrackingLog, first_leg_contact
+
+    n = 5
+    zeros = {k: np.zeros((n, 3)) for k in ("base_pos", "base_pos_ref", "orientation_error")}
+    log = TrackingLog(
+        t=np.arange(n) * 0.0025,
+        base_angvel=np.zeros((n, 3)),
+        base_angvel_ref=np.zeros((n, 3)),
+        forces=np.zeros((n, 4, 3)),
+        forces_ref=np.zeros((n, 4, 3)),
+        forces_qp=np.zeros((n, 4, 3)),
+        contact_ref=np.tile([True, True, False, True], (n, 1)),
+        stance=np.ones((n, 4), dtype=bool),
+        torques=np.zeros((n, 12)),
+        shin_contact=np.zeros((n, 4), dtype=bool),
+        qpos=np.zeros((n, 19)),
+        **zeros,
+    )
+    assert first_leg_contact(log) is None
+    log.shin_contact[3:, 2] = True  # LH from the fourth tick, planned in swing
+    log.shin_contact[4, 1] = True
+    assert first_leg_contact(log) == {"leg": "LH", "t": 0.0075, "planned": "swing"}
+    log.shin_contact[2, 1] = True  # RF earlier, planned in stance
+    assert first_leg_contact(log) == {"leg": "RF", "t": 0.005, "planned": "stance"}
+
+
+def test_the_first_pose_puts_planned_stance_feet_on_the_terrain_not_into_or_above_it():
+    from roughwalk.tracking.track import _start
+
+    robot = load_robot("anymal_c")
+    ns = robot.nominal_stance
+    base = np.array([0.0, 0.0, ns.base_height])
+    feet = np.array(ns.feet, dtype=float) + base
+    feet[:, 2] = [-0.04, 0.05, -0.003, 0.0]  # a plan's first stance feet 4 cm under, 5 cm over
+    terrain = terrain_covering(load_terrain("flat"), [[0.0, 0.0]])
+    world = tracking_world(robot, terrain, TrackingConfig())
+    assert _start(world, Reference.standing(base, feet, robot.mass)) == ""
+    mujoco.mj_forward(world.model, world.data)
+    centres = world.data.geom_xpos[world.roles.foot]
+    # Centimetres off: on the ground; millimetres off: as planned.
+    np.testing.assert_allclose(
+        centres[:, 2], robot.foot_radius + np.array([0, 0, -0.003, 0]), atol=1e-3
+    )
+    np.testing.assert_allclose(centres[:, :2], feet[:, :2], atol=1e-3)

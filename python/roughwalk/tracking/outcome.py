@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["TrackingOutcome", "TrackingLog"]
+__all__ = ["TrackingOutcome", "TrackingLog", "first_leg_contact"]
 
 
 @dataclass
@@ -108,6 +108,12 @@ class TrackingOutcome:
         solve); it follows the machine's load.
     mean_tick_cpu_ms:
         Mean CPU time [ms] of one control tick (400 Hz leaves 2.5 ms).
+    first_leg_contact:
+        The first touch of the terrain by a leg link other than a foot (a
+        shank or thigh): ``{"leg": "RF", "t": 4.66, "planned": "stance"}``,
+        the leg, the time [s] and the foot's planned phase then; None when no
+        leg link touched. On the pallets such a touch is often the first
+        visible step of a fall.
     log:
         Per-tick arrays (not in :meth:`to_dict`).
     """
@@ -129,6 +135,7 @@ class TrackingOutcome:
     slips: int
     mean_qp_time_ms: float
     mean_tick_cpu_ms: float = 0.0
+    first_leg_contact: dict[str, Any] | None = None
     log: TrackingLog | None = field(default=None, repr=False)
     video: str | None = None
 
@@ -140,3 +147,16 @@ class TrackingOutcome:
                 continue
             out[k] = None if isinstance(v, float) and not math.isfinite(v) else v
         return out
+
+
+LEG_NAMES = ("LF", "RF", "LH", "RH")
+
+
+def first_leg_contact(log: TrackingLog) -> dict[str, Any] | None:
+    """The first tick a leg link other than a foot touched the terrain (see TrackingOutcome)."""
+    hits = np.argwhere(np.asarray(log.shin_contact, dtype=bool))
+    if len(hits) == 0:
+        return None
+    tick, leg = (int(v) for v in hits[0])
+    planned = "stance" if bool(log.contact_ref[tick][leg]) else "swing"
+    return {"leg": LEG_NAMES[leg], "t": round(float(log.t[tick]), 4), "planned": planned}

@@ -21,7 +21,7 @@ import numpy as np
 from roughwalk.errors import InvalidArgumentError
 from roughwalk.tracking.config import TrackingConfig
 from roughwalk.tracking.controller import WholeBodyController, rotation_error, tracking_world
-from roughwalk.tracking.outcome import TrackingLog, TrackingOutcome
+from roughwalk.tracking.outcome import TrackingLog, TrackingOutcome, first_leg_contact
 from roughwalk.tracking.reach import LegReach, reach_aware_reference
 from roughwalk.tracking.reference import Reference, load_trajectory
 from roughwalk.tracking.world_terrain import terrain_covering
@@ -33,6 +33,9 @@ if TYPE_CHECKING:
     from roughwalk.trajopt.result import TrajoptResult
 
 __all__ = ["track", "execute_reference", "TrunkPush"]
+
+_START_FOOT_TOLERANCE_M = 0.01
+"""A planned first stance foot farther [m] from the terrain than this starts on it."""
 
 
 @dataclass(frozen=True)
@@ -157,7 +160,15 @@ def _start(world: World, reference: Reference) -> str:
     robot = world.robot
     first = reference(0.0)
     quat = first.base_quat
-    centres = first.feet_pos + np.array([0.0, 0.0, robot.foot_radius])
+    feet = first.feet_pos.copy()
+    # A plan after few solver iterations may start a stance foot centimetres
+    # inside or above the terrain (the learned initialiser's first pose is not
+    # exactly on it): start such feet on the terrain itself, not sunk into it
+    # with the shank or dropping onto it. Millimetres off are left as planned.
+    ground = world.terrain.height(feet[:, :2])
+    off = first.contact & (np.abs(feet[:, 2] - ground) > _START_FOOT_TOLERANCE_M)
+    feet[off, 2] = ground[off]
+    centres = feet + np.array([0.0, 0.0, robot.foot_radius])
     q, reachable = robot.inverse_kinematics(centres, first.base_pos, quat)
     if not reachable.all():
         return (
@@ -267,5 +278,6 @@ def _simulate(
         slips=counts["slip"],
         mean_qp_time_ms=1000.0 * qp_time / max(len(log.t), 1),
         mean_tick_cpu_ms=1000.0 * cpu_time / max(len(log.t), 1),
+        first_leg_contact=first_leg_contact(log),
         log=log,
     )
