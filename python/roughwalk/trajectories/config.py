@@ -123,7 +123,11 @@ class TimingConfig:
         The trunk under which the swing's joint speeds are estimated:
         ``"still"`` holds the swing pose throughout; ``"landing"``
         carries its height and tilt on to the landing certificate's, as the
-        initial trajectory does; ``"shorter"`` (default): the shorter of the two.
+        initial trajectory does; ``"shorter"`` (default): the shorter of the two;
+        ``"moving"``: the shortest of those and one whose trunk also moves
+        on horizontally to where the swing takes the ZMP (its exit), as the
+        preview controller moves it (the measured swing still lengthens a
+        step that would outrun the limits).
         Stepping down from the barrier (8 cm), the swing pose leaves the
         landing foot at the edge of its reach, where the knee's rate per
         metre soars: "still" timed that swing 1.12 s, "landing" 0.64 s (both
@@ -175,9 +179,9 @@ class TimingConfig:
             v = getattr(self, name)
             if not (math.isfinite(v) and v >= 1):
                 raise ConfigError(f"timing.{name} must be ≥ 1, got {v}")
-        if self.swing_trunk not in ("still", "landing", "shorter"):
+        if self.swing_trunk not in ("still", "landing", "shorter", "moving"):
             raise ConfigError(
-                "timing.swing_trunk must be 'still', 'landing' or 'shorter', "
+                "timing.swing_trunk must be 'still', 'landing', 'shorter' or 'moving', "
                 f"got {self.swing_trunk!r}"
             )
 
