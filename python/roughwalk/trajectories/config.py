@@ -145,7 +145,10 @@ class TimingConfig:
         push test (``test_one_reflex_rescues_a_push_to_the_right_mid_stride``,
         "even", 2.2 s) rolls over at 3.0 s instead of one reflex and a
         re-plan, and a straight 10 cm crawl's last step (RF) is invalid
-        (a joint speed limit, a supporting foot out of reach).
+        (a joint speed limit, a supporting foot out of reach). The 1 N·s
+        side push sweep (``roughwalk bench push_recovery --direction 90`` /
+        ``-90``) survives 16 and 15 of 17 as with the defaults, but at
+        other times: falls at 3.2 s to the left, 2.2 and 2.4 s to the right.
         Stepping down from the barrier (8 cm), the swing pose leaves the
         landing foot at the edge of its reach, where the knee's rate per
         metre soars: "still" timed that swing 1.12 s, "landing" 0.64 s (both
