@@ -243,4 +243,4 @@ def test_swing_timing_under_the_landing_trunk_shortens_a_step_down(robot) -> Non
     assert step.report.velocity_limits_ok, step.report.notes
     assert step.report.swing_s < still.swing_s
     with pytest.raises(rw.ConfigError, match="swing_trunk"):
-        rw.trajectories.trajectory_config(**{"timing.swing_trunk": "moving"})
+        rw.trajectories.trajectory_config(**{"timing.swing_trunk": "hovering"})

@@ -482,8 +482,14 @@ class ExecutorConfig:
         1.6 times the longest action (9.6 cm at 0.3 L on LittleDog, whose
         swings are joint-speed limited at 0.28–0.32 s: longer strides carry
         the feet farther per swing); ``footstep.max_foot_travel`` (0.6 L)
-        caps it at 0.375 L. Opt-in: see the class table in
-        ``benchmarks/bench_littledog.py``'s results.
+        grows with it up to 0.85 of the fore–aft span a foot reaches
+        (:mod:`roughwalk.sim.stride_reach`; 0.159 m, so ~0.42 L on
+        LittleDog). Opt-in: longer strides lengthen the joint-speed-bound
+        swings more than in proportion (demo course, 0.3 → 0.42 L: stride
+        9.4 → 11.5 cm, mean swing 0.36 → 0.50 s, 4.67 → 4.50 cm/s), and
+        barrier seed 0 fell at 0.42 L (RF's foot-force reflex stepping
+        onto the barrier, then a roll over the right feet in the re-plan's
+        first swing).
     """
 
     compute_time_scale: float = 1.0

@@ -17,6 +17,7 @@ from roughwalk.sim.executor import Executor, ProgressCallback
 from roughwalk.sim.footstep_source import CrawlSource, FootstepSource, default_source
 from roughwalk.sim.outcome import Outcome
 from roughwalk.sim.run_log import RunLog
+from roughwalk.sim.stride_reach import longer_step_config
 
 __all__ = ["run", "RunResult", "sim_config"]
 
@@ -101,18 +102,6 @@ def _pose(value: Sequence[float], n: int, what: str) -> tuple[float, ...]:
     return tuple(a)
 
 
-def _longer_steps(robot: Any, longest: float) -> Any:
-    """The footstep planner's settings with forward actions of ``longest`` × L added."""
-    from roughwalk.planning.footstep_config import FootstepConfig, hip_to_hip_length
-
-    base = FootstepConfig.for_robot(robot)
-    length = hip_to_hip_length(robot)
-    if longest * length <= max(a[0] for a in base.actions) + 1e-12:
-        return base
-    extra = tuple((longest * length, dy * length, 0.0) for dy in (-0.1, 0.0, 0.1))
-    return FootstepConfig.for_robot(robot, actions=base.actions + extra)
-
-
 def run(
     robot: Any,
     terrain: Any,
@@ -170,7 +159,7 @@ def run(
     budget = cfg.executor.plan_expansions or None
     options: dict[str, Any] = {"expansions": budget}
     if cfg.executor.longest_step > 0:
-        options["config"] = _longer_steps(robot_obj, cfg.executor.longest_step)
+        options["config"] = longer_step_config(robot_obj, cfg.executor.longest_step)
     if isinstance(planner, str):
         if planner == "auto":
             source: FootstepSource = default_source(robot_obj, seen, **options)

@@ -98,7 +98,8 @@ class TimingConfig:
         goal in both walk 3–5 % faster (barrier 5.67/5.72 → 5.92/6.01 cm/s,
         steps 5.57 → 5.80, sloped rocks 5.48 → 5.66, round rocks 4.42 →
         4.55); which other runs fail changes with the anytime planner's
-        plans (2 seeds cannot tell), so it stays opt-in.
+        plans (2 seeds cannot tell), so it stays opt-in; with ``swing_trunk``
+        "moving", see the figures there.
     min_hold_s:
         Shortest shift phase [s] whatever the travel (at most
         ``min_shift_s``): the landed foot's touchdown settles before the
@@ -123,7 +124,31 @@ class TimingConfig:
         The trunk under which the swing's joint speeds are estimated:
         ``"still"`` holds the swing pose throughout; ``"landing"``
         carries its height and tilt on to the landing certificate's, as the
-        initial trajectory does; ``"shorter"`` (default): the shorter of the two.
+        initial trajectory does; ``"shorter"`` (default): the shorter of the
+        two; ``"moving"``: the shortest of those and one whose trunk
+        also moves on horizontally to where the swing takes the ZMP (its
+        exit), as the preview controller moves it (the measured swing still
+        lengthens a step that would outrun the limits). "shorter" with
+        ``shift_travel_m`` 0 → "moving" with 0.02 (the trunk moves on
+        during the swings and the shifts that then carry the ZMP only a
+        little shrink to ``min_hold_s``) on the repeatable bench
+        (``roughwalk bench littledog --classes
+        barrier,steps,round_rocks,sloped_rocks --expansions 40000 --seeds
+        2``): barrier 2/2 at 4.10 → 5.31 cm/s, steps 2/2 at 3.86 → 4.22
+        (seed 1: 3 reflexes), round rocks 1/2 at 3.85 → 2/2 at 4.15, sloped
+        rocks 1/2 at 4.92 → 1/2 at 5.82 (the same seed falls at 1 s); the
+        demo course 4.67 → 5.56 cm/s (shifts 0.20 → 0.13 s, swings 0.36 →
+        0.34 s). With the fast timing on top (``min_shift_s`` 0.1,
+        ``min_swing_s`` 0.2, ``swing.time_law`` "joint"): barrier 5.75,
+        steps 5.26, round rocks 2/2 at 4.21, sloped rocks 1/2 at 6.86, demo
+        6.65 cm/s. Not the default: with "moving" and 0.02 the flat-ground
+        push test (``test_one_reflex_rescues_a_push_to_the_right_mid_stride``,
+        "even", 2.2 s) rolls over at 3.0 s instead of one reflex and a
+        re-plan, and a straight 10 cm crawl's last step (RF) is invalid
+        (a joint speed limit, a supporting foot out of reach). The 1 N·s
+        side push sweep (``roughwalk bench push_recovery --direction 90`` /
+        ``-90``) survives 16 and 15 of 17 as with the defaults, but at
+        other times: falls at 3.2 s to the left, 2.2 and 2.4 s to the right.
         Stepping down from the barrier (8 cm), the swing pose leaves the
         landing foot at the edge of its reach, where the knee's rate per
         metre soars: "still" timed that swing 1.12 s, "landing" 0.64 s (both
@@ -175,9 +200,9 @@ class TimingConfig:
             v = getattr(self, name)
             if not (math.isfinite(v) and v >= 1):
                 raise ConfigError(f"timing.{name} must be ≥ 1, got {v}")
-        if self.swing_trunk not in ("still", "landing", "shorter"):
+        if self.swing_trunk not in ("still", "landing", "shorter", "moving"):
             raise ConfigError(
-                "timing.swing_trunk must be 'still', 'landing' or 'shorter', "
+                "timing.swing_trunk must be 'still', 'landing', 'shorter' or 'moving', "
                 f"got {self.swing_trunk!r}"
             )
 

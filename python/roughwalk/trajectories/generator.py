@@ -179,12 +179,17 @@ class FootstepTrajectoryGenerator:
         return self._controllers[key]
 
     def nominal_timings(
-        self, seq: StepSequence, travels: Sequence[float] | None = None
+        self,
+        seq: StepSequence,
+        travels: Sequence[float] | None = None,
+        anchors: NDArray[np.float64] | None = None,
     ) -> list[StepTiming]:
         """Each footstep's timing before any restart (§5.2), in whole CHOMP samples.
 
         ``travels`` (S,) [m]: how far each step's shift moves the ZMP
         (:meth:`zmp_travels`), for the shift's floor; None: ``min_shift_s``.
+        ``anchors`` as in :class:`PreparedPlan`: with ``timing.swing_trunk``
+        "moving", where each swing carries the ZMP (:meth:`zmp_exit`).
         """
         out = []
         previous = seq.initial_pose
@@ -207,10 +212,14 @@ class FootstepTrajectoryGenerator:
                 "still": ("still",),
                 "landing": ("landing",),
                 "shorter": ("still", "landing"),
+                "moving": ("still", "landing", "moving"),
             }[self.config.timing.swing_trunk]
+            carry = np.zeros(2)
+            if anchors is not None and k + 2 < len(anchors):
+                carry = self.zmp_exit(step.support_triangle, anchors[k + 2]) - anchors[k + 1]
             timings = []
             for trunk in trunks:
-                legs_b = self._swing_legs_in_body(pose, step.end_pose, path, step.leg, trunk)
+                legs_b = self._swing_legs_in_body(pose, step.end_pose, path, step.leg, trunk, carry)
                 q, _ = self.wb.inverse_kinematics(legs_b)
                 timings.append(
                     step_timing(
@@ -236,6 +245,7 @@ class FootstepTrajectoryGenerator:
         path: NDArray[np.float64],
         leg: int,
         trunk: str,
+        carry: NDArray[np.float64] | None = None,
     ) -> NDArray[np.float64]:
         """The four feet (K, 4, 3) in the trunk frame along a swing foot path (K, 3) [m].
 
@@ -243,12 +253,19 @@ class FootstepTrajectoryGenerator:
         height and tilt go on to the landing certificate's (``end_pose``) as
         the initial trajectory's do (a smoothstep over the swing), its x–y
         held (the ZMP preview moves it less than the certificates differ).
+        "moving": as "landing", and its x–y moves on by ``carry`` (2,) [m]
+        to where the swing's ZMP reference goes (its exit, three quarters
+        into the swing): a foot swinging forward under a trunk that moves
+        forward turns its joints less.
         The supporting feet's rows are only for the IK.
         """
         k = len(path)
         base = np.repeat(pose.base_pos[None], k, axis=0)
         rotation = np.repeat(pose.rotation[None], k, axis=0)
-        if trunk == "landing":
+        if trunk == "moving" and carry is not None:
+            u = np.clip(np.linspace(0.0, 1.0, k) / 0.75, 0.0, 1.0)
+            base[:, :2] += (u * u * (3.0 - 2.0 * u))[:, None] * np.asarray(carry)[None, :2]
+        if trunk in ("landing", "moving"):
             u = np.linspace(0.0, 1.0, k)
             u = u * u * (3.0 - 2.0 * u)
             base[:, 2] += u * (end_pose.base_pos[2] - pose.base_pos[2])
@@ -432,7 +449,7 @@ class FootstepTrajectoryGenerator:
         for k, pose in enumerate(shortcuts):
             if pose is not None:
                 anchors[k + 1] = pose.com[:2]
-        timings = self.nominal_timings(seq, self.zmp_travels(seq, anchors))
+        timings = self.nominal_timings(seq, self.zmp_travels(seq, anchors), anchors)
         init = seq.initial_pose
         start = StartState(
             time=0.0,
