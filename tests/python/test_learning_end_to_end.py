@@ -99,6 +99,27 @@ def test_iteration_rounds_write_models_that_reload(experience: Path, tmp_path: P
     assert filter_good(resolved, rounds[0].train.g_max).n_good >= 10
 
 
+def test_cli_trains_a_library_model_of_round_two(experience: Path, tmp_path: Path) -> None:
+    from roughwalk.cli.main import main
+    from roughwalk.learning.experience import read_run
+
+    model = tmp_path / "library.npz"
+    args = ["init", "train", str(experience), "--out", str(model), "--layers", "8"]
+    assert main([*args, "--max-epochs", "20", "--round", "2", "--library"]) == 0
+    loaded = LearnedModel.load(model)
+    training = loaded.header["training"]
+    assert training["learned_init_round"] == 2
+    # The library holds D_good: every kept task's own solution, row for row.
+    assert loaded.library is not None and len(loaded.library) == training["n_good"]
+    assert loaded.header["library"]["n_solutions"] == training["n_good"]
+    data = read_run(experience)
+    tasks = np.column_stack([data["start"], data["goal"]])
+    for row in (0, len(loaded.library) - 1):
+        match = np.flatnonzero(np.all(np.isclose(tasks, loaded.library.tasks[row]), axis=1))
+        assert match.size == 1
+        np.testing.assert_allclose(loaded.library.x[row], data["x"][match[0]], rtol=1e-6)
+
+
 def test_cli_trains_a_model_that_optimize_uses(experience: Path, tmp_path: Path) -> None:
     from roughwalk.cli.main import main
 

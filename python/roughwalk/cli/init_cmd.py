@@ -87,6 +87,18 @@ def register(sub: Any) -> None:
     t.add_argument("--seed", type=int, default=0, help="training seed")
     t.add_argument("--max-epochs", type=int, default=300, help="L-BFGS iterations")
     t.add_argument("--note", default="", help="text stored in the model header")
+    t.add_argument(
+        "--round",
+        type=int,
+        default=1,
+        help="the LearnedInit round recorded in the header (default 1: heuristic data)",
+    )
+    t.add_argument(
+        "--library",
+        action="store_true",
+        help="also keep D_good's solutions and multipliers in the model (a solution "
+        "library): the guess is then a training solution, not the network's output",
+    )
     t.set_defaults(func=cmd_train)
 
     it = s.add_parser(
@@ -207,6 +219,8 @@ def cmd_train(args: argparse.Namespace) -> int:
         seed=args.seed,
         max_epochs=args.max_epochs,
         note=args.note,
+        learned_round=args.round,
+        library=args.library,
     )
     model.save(args.out)
     print(report.summary())
