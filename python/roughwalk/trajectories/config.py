@@ -155,10 +155,15 @@ class TimingConfig:
         35°. The defaults fall the same way (the same reflex, 34° 0.39 s
         later) when pushed at LF's lift-off, 2.78 s: that phase needs a
         wider stance or a sideways capture step of a right foot, not a
-        change of this setting. The 1 N·s side push sweep (``roughwalk
-        bench push_recovery --direction 90`` / ``-90``) survives 16 and 15
-        of 17 as with the defaults, but at other times: falls at 3.2 s to
-        the left, 2.2 and 2.4 s to the right. A straight 10 cm crawl's last
+        change of this setting. With "moving" and 0.02 the 1 N·s side push
+        sweep (``roughwalk bench push_recovery --direction 90`` / ``-90``)
+        survives 16 and 15 of 17 as with the defaults, but at other times:
+        falls at 3.2 s to the left, 2.2 and 2.4 s to the right.
+        ``zmp.support_margin`` 0.02 on top is no fix, though both sweeps
+        then survive 16 of 17 (falls at 3.2 s left, 2.4 s right) and the
+        test passes: its push lands 0.04 s before LF lifts, the CoM again
+        4.0 cm inside, the capture point 0.1 cm past the edge at worst
+        (demo 5.46 cm/s). A straight 10 cm crawl's last
         step (RF) is invalid with either setting: its swing pose, over LF
         10 cm ahead, does not reach RF's start at lift-off (with "moving"
         and 0.02 the unstretched 0.06 s shift also breaks a joint speed
