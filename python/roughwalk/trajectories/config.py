@@ -144,11 +144,30 @@ class TimingConfig:
         6.65 cm/s. Not the default: with "moving" and 0.02 the flat-ground
         push test (``test_one_reflex_rescues_a_push_to_the_right_mid_stride``,
         "even", 2.2 s) rolls over at 3.0 s instead of one reflex and a
-        re-plan, and a straight 10 cm crawl's last step (RF) is invalid
-        (a joint speed limit, a supporting foot out of reach). The 1 N·s
-        side push sweep (``roughwalk bench push_recovery --direction 90`` /
-        ``-90``) survives 16 and 15 of 17 as with the defaults, but at
-        other times: falls at 3.2 s to the left, 2.2 and 2.4 s to the right.
+        re-plan. The faster gait, not the recovery, moves the push: the
+        same-side shift before LF shrinks to ``min_hold_s`` (0.2 → 0.06
+        s), so LF lifts as the push lands, the CoM 4.0 cm inside the RF–RH
+        edge (5.1 cm with the defaults, whose push lands in the shift
+        before LH with four feet down). Its capture point crosses that
+        edge 0.09 s later, before the foot-force reflex fires (0.13 s);
+        the recovery then lowers LF and LH, which can only push, never
+        pull, so the left feet do not touch again and the roll grows 5° →
+        35°. The defaults fall the same way (the same reflex, 34° 0.39 s
+        later) when pushed at LF's lift-off, 2.78 s: that phase needs a
+        wider stance or a sideways capture step of a right foot, not a
+        change of this setting. With "moving" and 0.02 the 1 N·s side push
+        sweep (``roughwalk bench push_recovery --direction 90`` / ``-90``)
+        survives 16 and 15 of 17 as with the defaults, but at other times:
+        falls at 3.2 s to the left, 2.2 and 2.4 s to the right.
+        ``zmp.support_margin`` 0.02 on top is no fix, though both sweeps
+        then survive 16 of 17 (falls at 3.2 s left, 2.4 s right) and the
+        test passes: its push lands 0.04 s before LF lifts, the CoM again
+        4.0 cm inside, the capture point 0.1 cm past the edge at worst
+        (demo 5.46 cm/s). A straight 10 cm crawl's last
+        step (RF) is invalid with either setting: its swing pose, over LF
+        10 cm ahead, does not reach RF's start at lift-off (with "moving"
+        and 0.02 the unstretched 0.06 s shift also breaks a joint speed
+        limit); a 9 cm crawl is valid throughout with both.
         Stepping down from the barrier (8 cm), the swing pose leaves the
         landing foot at the edge of its reach, where the knee's rate per
         metre soars: "still" timed that swing 1.12 s, "landing" 0.64 s (both
