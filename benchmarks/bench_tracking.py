@@ -18,6 +18,9 @@ problem, ``towr_config``), both executed; pictures of each go beside the JSON.
 The ``learned`` initialiser comes from ``roughwalk.learning`` when it is
 installed; otherwise the benchmark says so and runs the heuristic only.
 
+``--models DIR`` runs ``learned`` with the model file in DIR that fits each
+problem instead of the shipped one (a candidate before it is shipped).
+
 Run: ``roughwalk bench tracking [--tasks N] [--iters 0,5] [--env single_pallet]``.
 Writes ``benchmarks/results/tracking.json``.
 """
@@ -102,29 +105,63 @@ def learned_available() -> str:
     return ""
 
 
-def learned_model_for(env_terrain: str, optimize_durations: bool) -> str:
-    """Why no learned model fits this benchmark's problem on ``env_terrain`` ("" when one does)."""
+def learned_init(env_terrain: str, optimize_durations: bool, models: Path | None) -> str:
+    """The learned initialiser for this problem: the shipped model, or the one in ``models``.
+
+    ``models`` is a folder of model files (``--models``); the first whose
+    header fits the problem is used as ``learned:FILE``, so that a candidate
+    model is benchmarked before it replaces the shipped one. A folder with
+    no fitting model gives "learned:" + the folder, which
+    :func:`learned_model_for` then reports as unusable.
+    """
+    if models is None:
+        return "learned"
+    try:
+        from roughwalk.learning.model_file import LearnedModel
+    except ImportError:
+        return "learned"
+    signature = _spec(env_terrain, optimize_durations).to_dict()
+    for path in sorted(models.glob("*.npz")):
+        if not LearnedModel.load(path).mismatches(signature):
+            return f"learned:{path}"
+    return f"learned:{models}"
+
+
+def learned_model_for(env_terrain: str, optimize_durations: bool, init: str = "learned") -> str:
+    """Why ``init``'s model does not fit the problem on ``env_terrain`` ("" when it does)."""
     try:
         from roughwalk.learning.initializer import model_for_spec
 
-        model_for_spec("learned", _spec(env_terrain, optimize_durations))
+        model_for_spec(init, _spec(env_terrain, optimize_durations))
     except Exception as e:  # noqa: BLE001  (no model: run without it, and say why)
         return f"{type(e).__name__}: {e}"
     return ""
 
 
-def constraints_for(env_terrain: str, optimize_durations: bool) -> tuple[str, ...] | None:
-    """The constraint set of the shipped learned model for this problem (None: the default).
+def constraints_for(
+    env_terrain: str, optimize_durations: bool, init: str = "learned"
+) -> tuple[str, ...] | None:
+    """The constraint set of ``init``'s learned model for this problem (None: the default).
 
     Every initialiser solves the same NLP on an environment: the one the
     learned model was trained on (the double pallet's adds
-    ``unilateral_between_nodes``), so that the initialisers compare on one problem.
+    ``unilateral_between_nodes``), so that the initialisers compare on one
+    problem. ``init`` is "learned" (the shipped model) or "learned:FILE".
     """
     try:
-        from roughwalk.learning.model_constraints import spec_for_learned
+        from roughwalk.errors import ConfigError
+        from roughwalk.learning.initializer import model_for_spec
+        from roughwalk.learning.model_constraints import constraints_for_model, spec_for_learned
     except ImportError:
         return None
-    return spec_for_learned(_spec(env_terrain, optimize_durations)).constraints
+    spec = _spec(env_terrain, optimize_durations)
+    if init == "learned":
+        return spec_for_learned(spec).constraints
+    try:
+        model = model_for_spec(init, spec)
+    except ConfigError:
+        return None
+    return constraints_for_model(model, spec.config().constraints)
 
 
 def _spec(env_terrain: str, optimize_durations: bool) -> Any:
@@ -147,7 +184,7 @@ def run_job(job: Job) -> dict[str, Any]:
     from roughwalk.tracking import track
     from roughwalk.trajopt import Task, melon_config, optimize_motion
 
-    if job.init == "learned":
+    if job.init.partition(":")[0] == "learned":
         import roughwalk.learning  # noqa: F401
     robot = load_robot("anymal_c")
     terrain = load_terrain(job.terrain)
@@ -345,6 +382,11 @@ def main() -> None:
         default="",
         help="controller settings that differ from the default, e.g. track_com=true",
     )
+    parser.add_argument(
+        "--models",
+        type=Path,
+        help="folder of model files: 'learned' uses the one that fits (default: shipped)",
+    )
     parser.add_argument("--json", type=Path, default=RESULTS, help="where to write the results")
     args = parser.parse_args()
 
@@ -366,10 +408,12 @@ def main() -> None:
         if note:
             notes.append(f"{env}: {note}")
             print(notes[-1])
-        for init in inits:
+        for name in inits:
             for opt in durations:
-                constraints = constraints_for(terrain, opt)
-                why = learned_model_for(terrain, opt) if init == "learned" else ""
+                learned = learned_init(terrain, opt, args.models)
+                constraints = constraints_for(terrain, opt, learned)
+                init = learned if name == "learned" else name
+                why = learned_model_for(terrain, opt, init) if name == "learned" else ""
                 if why:
                     notes.append(f"{env}: learned initialiser skipped ({why})")
                     print(notes[-1])

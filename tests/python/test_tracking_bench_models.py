@@ -1,0 +1,56 @@
+"""The tracking bench's ``--models DIR``: a candidate model is run and solved with its own set."""
+
+from __future__ import annotations
+
+import importlib.util
+import shutil
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+pytest.importorskip("roughwalk.learning")
+
+from roughwalk.learning.initializer import MODELS_DIR  # noqa: E402
+from roughwalk.trajopt.parameters import MELON_REACH_CONSTRAINTS  # noqa: E402
+
+BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_tracking.py"
+DOUBLE = MODELS_DIR / "anymal_c_double_pallet_walk16.npz"
+
+
+def _bench() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("bench_tracking", BENCH)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclasses look their module up there
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture
+def candidate(tmp_path: Path) -> Path:
+    """A folder holding one double-pallet model under another name."""
+    shutil.copy(DOUBLE, tmp_path / "candidate.npz")
+    return tmp_path
+
+
+def test_without_a_folder_the_shipped_model_is_used() -> None:
+    bench = _bench()
+    assert bench.learned_init("double_pallet", False, None) == "learned"
+
+
+def test_the_folder_s_model_that_fits_the_problem_is_used(candidate: Path) -> None:
+    bench = _bench()
+    init = bench.learned_init("double_pallet", False, candidate)
+    assert init == f"learned:{candidate / 'candidate.npz'}"
+    assert bench.learned_model_for("double_pallet", False, init) == ""
+    chosen = bench.constraints_for("double_pallet", False, init)
+    assert chosen == (*MELON_REACH_CONSTRAINTS, "unilateral_between_nodes")
+
+
+def test_a_folder_without_a_fitting_model_is_reported_not_replaced(candidate: Path) -> None:
+    bench = _bench()
+    init = bench.learned_init("single_pallet", False, candidate)
+    assert init == f"learned:{candidate}"
+    assert bench.learned_model_for("single_pallet", False, init) != ""
