@@ -286,6 +286,13 @@ class TrajoptSolver:
             solver_options["hess_lag"] = nlp.hess_lag
         self._options = {
             **solver_options,
+            # Without these, nlpsol differentiates the whole NLP once more in MX
+            # ("nlp_grad", for the multipliers of p, which nothing here reads):
+            # 0.06 s of the flat trot's 0.40 s build, 0.17 s with optimised
+            # durations, and an evaluation after every solve. lam_x and lam_g
+            # are IPOPT's own either way.
+            "no_nlp_grad": True,
+            "calc_lam_p": False,
             "ipopt": ipopt,
             "print_time": False,
             "iteration_callback": self._monitor,

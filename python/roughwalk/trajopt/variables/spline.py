@@ -90,8 +90,8 @@ class NodeSpline:
     ) -> None:
         if len(positions) != len(durations) + 1 or len(velocities) != len(positions):
             raise ValueError("a spline needs one node more than it has polynomials")
-        self.positions = [ca.SX(p) for p in positions]
-        self.velocities = [ca.SX(v) for v in velocities]
+        self.positions = [p if isinstance(p, ca.SX) else ca.SX(p) for p in positions]
+        self.velocities = [v if isinstance(v, ca.SX) else ca.SX(v) for v in velocities]
         self.durations = list(durations)
         self.fixed = all(isinstance(d, int | float) for d in durations)
         self.starts: list[Any] = [0.0]
