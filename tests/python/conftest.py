@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+import roughwalk
 from roughwalk.terrain import Terrain
 
 SHARED_DIR = Path(__file__).resolve().parents[2].parent / "shared"
@@ -38,3 +39,9 @@ def littledog_board(shared_dir: Path) -> Callable[[str], Terrain]:
         return _load_board(shared_dir / "terrains" / "littledog" / f"{stem}.mat")
 
     return load
+
+
+@pytest.fixture(scope="module")
+def littledog() -> roughwalk.Robot:
+    """Our LittleDog model, loaded once per test module."""
+    return roughwalk.load_robot("littledog")

@@ -16,11 +16,6 @@ from roughwalk.sim.footstep_source import FootstepSource, PlanAttempt, PlannerSo
 HAVE_PLANNER = hasattr(_core, "FootstepPlanner")
 
 
-@pytest.fixture(scope="module")
-def littledog() -> roughwalk.Robot:
-    return roughwalk.load_robot("littledog")
-
-
 def source(robot: roughwalk.Robot, terrain: roughwalk.Terrain) -> FootstepSource:
     """The anytime planner in its deterministic mode (an expansion budget), else the crawl."""
     if HAVE_PLANNER:

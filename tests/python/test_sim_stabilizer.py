@@ -19,11 +19,6 @@ from roughwalk.sim.runner import Runner
 from roughwalk.sim.world import World
 
 
-@pytest.fixture(scope="module")
-def littledog() -> roughwalk.Robot:
-    return roughwalk.load_robot("littledog")
-
-
 def test_centre_of_pressure_is_the_force_weighted_mean_of_the_feet() -> None:
     feet = np.array([[0.1, 0.05, 0.0], [0.1, -0.05, 0.02], [-0.1, 0.05, 0.0], [-0.1, -0.05, 0.0]])
     forces = np.zeros((4, 3))

@@ -15,11 +15,6 @@ from roughwalk.sim.stride_reach import (
 )
 
 
-@pytest.fixture(scope="module")
-def littledog() -> rw.Robot:
-    return rw.load_robot("littledog")
-
-
 def reaches(robot: rw.Robot, leg: int, dx: float) -> bool:
     stance = robot.nominal_stance
     base = np.array([0.0, 0.0, stance.base_height])

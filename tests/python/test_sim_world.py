@@ -21,11 +21,6 @@ from roughwalk.terrain import list_generators
 
 
 @pytest.fixture(scope="module")
-def littledog() -> roughwalk.Robot:
-    return roughwalk.load_robot("littledog")
-
-
-@pytest.fixture(scope="module")
 def flat() -> roughwalk.Terrain:
     return roughwalk.load_terrain("flat")
 
