@@ -195,13 +195,13 @@ class TimingConfig:
     velocity_margin: float = 1.6
     swing_velocity_margin: float = 1.1
     min_shift_s: float = 0.2
-    shift_travel_m: float = 0.0
+    shift_travel_m: float = 0.02
     min_hold_s: float = 0.06
     first_shift_s: float = 0.0
     min_swing_s: float = 0.3
     max_step_s: float = 4.0
     settle_s: float = 0.8
-    swing_trunk: str = "shorter"
+    swing_trunk: str = "moving"
 
     def shift_floor(self, travel: float) -> float:
         """Shortest shift phase [s] for a ZMP travel of ``travel`` [m]."""
