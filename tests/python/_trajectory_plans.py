@@ -16,6 +16,49 @@ BARRIER = "barrier:height=0.04,thickness=0.01,center=1.0"
 """A 4 cm high, 1 cm thick wall across the board at x = 1 m (0.995 … 1.005)."""
 
 
+def one_step_plan(
+    robot: rw.Robot,
+    terrain: rw.Terrain,
+    wb: WholeBody,
+    feet: np.ndarray,
+    leg: str,
+    target: np.ndarray,
+    lower: float,
+) -> dict[str, Any]:
+    """The plan of one step of ``leg`` from the foot centres ``feet`` to ``target``.
+
+    The trunk is ``lower`` [m] below the nominal stance fitted to the feet,
+    before and after; the certificate after the step keeps all four feet
+    in reach. Contact points are the foot centres less the radius.
+    """
+    r = robot.foot_radius
+    base, rpy = nominal_fit(wb, feet)
+    base[2] -= lower
+    after = feet.copy()
+    after[LEG_NAMES.index(leg)] = target
+    end_base, end_rpy = nominal_fit(wb, after)
+    end_base[2] -= lower
+    end = pose_over_support(wb, after, [0, 1, 2, 3], 0.015, start=(end_base, end_rpy))
+    return {
+        "robot": robot.name,
+        "terrain": terrain.spec,
+        "footsteps": [
+            {"leg": name, "x": float(f[0]), "y": float(f[1]), "z": float(f[2] - r)}
+            for name, f in zip(LEG_NAMES, feet, strict=True)
+        ]
+        + [{"leg": leg, "x": float(target[0]), "y": float(target[1]), "z": float(target[2] - r)}],
+        "initial_pose": {"base_pos": base.tolist(), "base_quat": rpy_to_quat(rpy).tolist()},
+        "certificates": [
+            {
+                "step": 1,
+                "base_pos": end.base_pos.tolist(),
+                "base_quat": end.base_quat.tolist(),
+                "q": robot.from_canonical(end.q.reshape(12)).tolist(),
+            }
+        ],
+    }
+
+
 def barrier_step_plan(
     robot: rw.Robot,
     terrain: rw.Terrain,
@@ -39,32 +82,7 @@ def barrier_step_plan(
     feet[3 if i == 2 else 2, 0] -= 0.05
     target = feet[i].copy()
     target[0] += stride
-    base, rpy = nominal_fit(wb, feet)
-    base[2] -= lower
-    after = feet.copy()
-    after[i] = target
-    end_base, end_rpy = nominal_fit(wb, after)
-    end_base[2] -= lower
-    end = pose_over_support(wb, after, [0, 1, 2, 3], 0.015, start=(end_base, end_rpy))
-    return {
-        "robot": robot.name,
-        "terrain": terrain.spec,
-        # Contact points on the flat ground: the foot centres less the radius.
-        "footsteps": [
-            {"leg": name, "x": float(f[0]), "y": float(f[1]), "z": 0.0}
-            for name, f in zip(LEG_NAMES, feet, strict=True)
-        ]
-        + [{"leg": leg, "x": float(target[0]), "y": float(target[1]), "z": 0.0}],
-        "initial_pose": {"base_pos": base.tolist(), "base_quat": rpy_to_quat(rpy).tolist()},
-        "certificates": [
-            {
-                "step": 1,
-                "base_pos": end.base_pos.tolist(),
-                "base_quat": end.base_quat.tolist(),
-                "q": robot.from_canonical(end.q.reshape(12)).tolist(),
-            }
-        ],
-    }
+    return one_step_plan(robot, terrain, wb, feet, leg, target, lower)
 
 
 def low_swing_config(**more: Any) -> dict[str, Any]:
@@ -112,28 +130,4 @@ def step_down_plan(
     target = feet[0].copy()
     target[0] += stride
     target[2] = r
-    base, rpy = nominal_fit(wb, feet)
-    base[2] -= 0.02
-    after = feet.copy()
-    after[0] = target
-    end_base, end_rpy = nominal_fit(wb, after)
-    end_base[2] -= 0.02
-    end = pose_over_support(wb, after, [0, 1, 2, 3], 0.015, start=(end_base, end_rpy))
-    return {
-        "robot": robot.name,
-        "terrain": terrain.spec,
-        "footsteps": [
-            {"leg": name, "x": float(f[0]), "y": float(f[1]), "z": float(f[2] - r)}
-            for name, f in zip(LEG_NAMES, feet, strict=True)
-        ]
-        + [{"leg": "LF", "x": float(target[0]), "y": float(target[1]), "z": 0.0}],
-        "initial_pose": {"base_pos": base.tolist(), "base_quat": rpy_to_quat(rpy).tolist()},
-        "certificates": [
-            {
-                "step": 1,
-                "base_pos": end.base_pos.tolist(),
-                "base_quat": end.base_quat.tolist(),
-                "q": robot.from_canonical(end.q.reshape(12)).tolist(),
-            }
-        ],
-    }
+    return one_step_plan(robot, terrain, wb, feet, "LF", target, 0.02)
