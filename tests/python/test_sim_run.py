@@ -109,27 +109,44 @@ def test_a_push_beyond_the_threshold_triggers_a_reflex_and_a_replan(littledog) -
     assert blind.outcome.reflexes == 0 and blind.outcome.replans == 0
 
 
-@pytest.mark.parametrize(("law", "at_s"), [("knots", 2.0), ("knots", 2.6), ("even", 2.2)])
+OLD_TIMING = {"timing.swing_trunk": "shorter", "timing.shift_travel_m": 0.0}
+"""The timing defaults until session 9, which the old gaits' push times name."""
+
+GAITS = {
+    "knots": {"swing.time_law": "knots", "swing.lift_fraction": 0.1, **OLD_TIMING},
+    "even": {"swing.time_law": "even", "swing.lift_fraction": 0.3, **OLD_TIMING},
+    "default": {},
+}
+
+
+@pytest.mark.parametrize(
+    ("gait", "at_s"), [("knots", 2.0), ("knots", 2.6), ("even", 2.2), ("default", 3.2)]
+)
 def test_one_reflex_rescues_a_push_to_the_right_mid_stride(
-    littledog, law: str, at_s: float
+    littledog, gait: str, at_s: float
 ) -> None:
-    # With the "knots" swing timing (the default until session 4, whose
-    # gait phases these times name): pushed right at 2 s (RF about to lift),
-    # the robot once went through five reflexes and fell: the recovery's
-    # trunk twisted 12° off its target yaw, so the re-plan's blend began
-    # with an orientation error that fired the next reflex at once, and
-    # each re-plan started from a worse stance. At 2.6 s the trunk still
-    # rocked when the timed hold ended, and the re-plan's first step,
-    # lifting RF, tipped it over. The "even" timing's shorter swings put
-    # 2.0 s where the push fires no reflex; at 2.2 s it does.
-    timing = {"swing.time_law": law, "swing.lift_fraction": 0.1 if law == "knots" else 0.3}
+    # With the "knots" swing timing (the default until session 4): pushed
+    # right at 2 s (now late in RH's swing, RF next), the robot once went
+    # through five reflexes and fell: the recovery's trunk twisted 12° off
+    # its target yaw, so the re-plan's blend began with an orientation
+    # error that fired the next reflex at once, and each re-plan started
+    # from a worse stance. At 2.6 s (mid RF swing) the trunk still rocked
+    # when the timed hold ended, and the re-plan's first step, lifting RF,
+    # tipped it over. The "even" timing's shorter swings put 2.0 s where
+    # the push fires no reflex; at 2.2 s (the shift before LH, four feet
+    # down) it does. The default gait (session 9: the trunk moves on during
+    # the swings, shifts that carry the ZMP little shrink to 0.06 s) is
+    # pushed 0.14 s into RF's 0.36 s swing, towards the lifted foot (one
+    # reflex rescues it from 3.05 to 3.25 s). Pushed as LF or RH lifts
+    # (2.2 s, 2.7 s) it rolls over to the right, as the "even" gait does
+    # when pushed as its LF lifts (2.78 s).
     terrain = roughwalk.load_terrain("flat")
     push = Push(impulse_ns=1.0, at_s=at_s, direction_deg=-90.0)
     result = walk(
         littledog,
         terrain,
         disturbances=[push],
-        trajectory_config=roughwalk.trajectories.trajectory_config(**timing),
+        trajectory_config=roughwalk.trajectories.trajectory_config(**GAITS[gait]),
     )
     assert result.outcome.reflexes == 1 and result.outcome.replans == 1
     assert_walked_to_goal(result)

@@ -339,7 +339,9 @@ def test_objective_decreases_at_every_iteration_on_a_footstep(barrier_state) -> 
         )
         u = np.array(chomp.optimize(xi0, 15, stop_when_feasible=False).objective)
         assert np.all(np.diff(u) < 0), u
-        assert u[-1] < 0.8 * u[0]
+        # The body pass drops 22 % with a 0.4 s swing, 18 % with the 0.34 s
+        # that timing.swing_trunk "moving" gives this step.
+        assert u[-1] < 0.85 * u[0]
 
 
 def test_covariant_update_is_invariant_to_the_number_of_samples() -> None:

@@ -67,8 +67,15 @@ def test_a_shift_that_moves_the_zmp_less_takes_less_down_to_the_hold() -> None:
     moving = still.copy()
     moving[1, 0, 1] = 1.0
     assert step_timing(moving, swing, limits, cfg, 0, zmp_travel=0.0).shift_s == pytest.approx(0.16)
+    # The shift is timed by its path's peak rate: the same 1 rad, half of it
+    # in one tenth of the trunk's path (a leg near the edge of its reach).
+    uneven = np.zeros((11, 4, 3))
+    uneven[:, 0, 1] = np.r_[np.linspace(0.0, 0.5, 10), 1.0]
+    assert step_timing(uneven, swing, limits, cfg, 0, zmp_travel=0.0).shift_s == pytest.approx(
+        1.6 * 0.5 * 10 / 10.0
+    )
     # Without a travel scale every shift takes min_shift_s.
-    assert TimingConfig(min_shift_s=0.2).shift_floor(0.0) == pytest.approx(0.2)
+    assert TimingConfig(min_shift_s=0.2, shift_travel_m=0.0).shift_floor(0.0) == pytest.approx(0.2)
     # The hold never makes a shift longer than min_shift_s.
     assert TimingConfig(min_shift_s=0.05, shift_travel_m=0.02).shift_floor(0.0) == 0.05
 

@@ -8,9 +8,13 @@ A footstep is a shift phase (four feet down, the centre of pressure moves
 into the next support triangle) followed by a step (swing) phase.
 
 The shift uses that rule with a margin (the CoM's smooth motion peaks near
-twice its mean speed). The swing foot follows a known spline, so its leg's
-minimum time is exact: the least duration at which the spline's peak joint
-speeds stay within the limits (:func:`min_profile_time`).
+twice its mean speed), over the peak joint rate along the trunk's path rather
+than only its ends: a supporting leg near the edge of its reach turns its
+joints several times faster per metre of trunk motion, so a shift that moves
+the ZMP little (and whose floor is small, :meth:`TimingConfig.shift_floor`)
+is still long enough for its legs. The swing foot follows a known spline, so
+its leg's minimum time is exact: the least duration at which the spline's
+peak joint speeds stay within the limits (:func:`min_profile_time`).
 """
 
 from __future__ import annotations
@@ -117,9 +121,10 @@ def step_timing(
     Parameters
     ----------
     shift_path:
-        Joint angles (K, 4, 3) [rad] the shift passes through (at least its
-        start and end: the trunk moves from its start pose to the pose
-        certificate with all four feet held).
+        Joint angles (K ≥ 2, 4, 3) [rad] at K uniform fractions of the
+        trunk's path in the shift (from its start pose to the pose
+        certificate with all four feet held); timed by their peak rate
+        (:func:`min_profile_time`), which for K = 2 is the ends' travel.
     swing_profile:
         The swing leg's angles (K, 3) [rad] along its foot spline at K
         uniform time fractions (start to target).
@@ -142,7 +147,9 @@ def step_timing(
     floor = config.min_shift_s if zmp_travel is None else config.shift_floor(zmp_travel)
     if from_rest:
         floor = max(floor, config.first_shift_s)
-    shift = min_joint_time(np.asarray(shift_path, dtype=float).reshape(-1, 12), limits.reshape(12))
+    shift = min_profile_time(
+        np.asarray(shift_path, dtype=float).reshape(-1, 12), limits.reshape(12)
+    )
     swing = min_profile_time(
         np.asarray(swing_profile, dtype=float).reshape(-1, 3), limits[swing_leg]
     )
