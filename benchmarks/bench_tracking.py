@@ -59,6 +59,10 @@ class Job:
     """TrackingConfig fields that differ from the default (``--tracking``)."""
     constraints: tuple[str, ...] | None = None
     """The NLP's constraint set (None: ``melon_config``'s default)."""
+    trajopt: tuple[tuple[str, Any], ...] = ()
+    """TrajoptConfig fields that differ from ``melon_config``'s (``--trajopt``)."""
+    add_constraints: tuple[str, ...] = ()
+    """Constraints appended to the set (``--add-constraints``), e.g. ``force_between_nodes``."""
 
 
 def _task_space(env: str) -> tuple[str, list[Any] | None, str]:
@@ -193,6 +197,10 @@ def run_job(job: Job) -> dict[str, Any]:
     )
     if job.constraints is not None:
         config = replace(config, constraints=job.constraints)
+    if job.trajopt:
+        config = replace(config, **dict(job.trajopt))
+    if job.add_constraints:
+        config = replace(config, constraints=config.constraints + job.add_constraints)
     row: dict[str, Any] = {
         "env": job.env,
         "init": job.init,
@@ -343,16 +351,28 @@ def figure4(out_dir: Path) -> list[dict[str, Any]]:
 
 def _tracking_settings(text: str) -> tuple[tuple[str, Any], ...]:
     """``NAME=VALUE,...`` as TrackingConfig fields (true/false, numbers), checked by name."""
-    import dataclasses
-
     from roughwalk.tracking import TrackingConfig
 
-    names = {f.name for f in dataclasses.fields(TrackingConfig)}
+    return _settings(text, TrackingConfig, "--tracking")
+
+
+def _trajopt_settings(text: str) -> tuple[tuple[str, Any], ...]:
+    """``NAME=VALUE,...`` as TrajoptConfig fields (true/false, numbers), checked by name."""
+    from roughwalk.trajopt import TrajoptConfig
+
+    return _settings(text, TrajoptConfig, "--trajopt")
+
+
+def _settings(text: str, cls: type, option: str) -> tuple[tuple[str, Any], ...]:
+    """``NAME=VALUE,...`` as fields of the dataclass ``cls`` (true/false, numbers)."""
+    import dataclasses
+
+    names = {f.name for f in dataclasses.fields(cls)}
     out = []
     for item in filter(None, (v.strip() for v in text.split(","))):
         name, _, value = item.partition("=")
         if name not in names:
-            raise SystemExit(f"--tracking: TrackingConfig has no field {name!r}")
+            raise SystemExit(f"{option}: {cls.__name__} has no field {name!r}")
         low = value.lower()
         parsed: Any = low == "true" if low in ("true", "false") else float(value)
         out.append((name, parsed))
@@ -383,6 +403,16 @@ def main() -> None:
         help="controller settings that differ from the default, e.g. track_com=true",
     )
     parser.add_argument(
+        "--trajopt",
+        default="",
+        help="NLP settings that differ from melon_config's, e.g. dt_dynamics=0.05",
+    )
+    parser.add_argument(
+        "--add-constraints",
+        default="",
+        help="constraints appended to every solve's set, e.g. force_between_nodes",
+    )
+    parser.add_argument(
         "--models",
         type=Path,
         help="folder of model files: 'learned' uses the one that fits (default: shipped)",
@@ -393,8 +423,12 @@ def main() -> None:
     n = 100 if args.full else args.tasks
     iters = [int(v) for v in args.iters.split(",") if v]
     tracking = _tracking_settings(args.tracking)
+    trajopt = _trajopt_settings(args.trajopt)
     inits = [v for v in args.init.split(",") if v]
     notes = [f"tracking settings: {dict(tracking)}"] if tracking else []
+    notes += [f"NLP settings: {dict(trajopt)}"] if trajopt else []
+    added = tuple(v for v in args.add_constraints.split(",") if v)
+    notes += [f"constraints added: {added}"] if added else []
     if "learned" in inits:
         why = learned_available()
         if why:
@@ -432,6 +466,8 @@ def main() -> None:
                                 t.goal,
                                 tracking,
                                 constraints,
+                                trajopt,
+                                added,
                             )
                         )
     print(f"{len(jobs)} solve-and-execute jobs ...", flush=True)
