@@ -130,7 +130,7 @@ _WRITER = textwrap.dedent(
     x = ca.SX.sym("x", 3)
     p = ca.SX.sym("p", 1)
     # Enough code that the two compilations overlap.
-    f = sum(ca.sin(x[i % 3] * (i + 1) + p) for i in range(1500))
+    f = sum(ca.sin(x[i % 3] * (i + 1) + p) for i in range(500))
     nlp = ca.Function("nlp", [x, p], [f, x], ["x", "p"], ["f", "g"])
     layout = {"lbg": np.zeros(3), "ubg": np.full(3, np.inf), "row_layout": [("box", 3)],
               "cost_names": [], "n_variables": 3}
@@ -154,7 +154,7 @@ def test_concurrent_writers_leave_one_intact_entry(tmp_path: Path) -> None:
     assert np.isinf(loaded.ubg).all()
     f, g = loaded.functions["nlp"](ca.DM([0.1, 0.2, 0.3]), 0.5)
     x = [0.1, 0.2, 0.3]
-    expected = sum(np.sin(x[i % 3] * (i + 1) + 0.5) for i in range(1500))
+    expected = sum(np.sin(x[i % 3] * (i + 1) + 0.5) for i in range(500))
     assert float(f) == pytest.approx(expected, rel=1e-12)
     np.testing.assert_array_equal(np.asarray(g).ravel(), x)
 

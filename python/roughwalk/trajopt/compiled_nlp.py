@@ -49,13 +49,20 @@ __all__ = [
     "compile_and_store",
 ]
 
-COMPILER_FLAGS = ("-O0",)
+COMPILER_FLAGS = ("-O1",)
 """gcc's flags. The generated C is large (4.9 MB for TOWR's flat 16-step trot
-with fixed durations, 20 MB with optimised ones), and its Jacobian is one
-function of 150 000 lines: ``-O1`` took 129 s of CPU on the trot, ``-O0``
-11 s, while the functions are a small part of an iteration (IPOPT and MUMPS
-are the rest: 0.209 s compiled at -O1 against 0.218 s in CasADi's virtual
-machine for the trot's 22 iterations)."""
+with fixed durations, 20 MB with optimised ones) and its Jacobian is one
+function of 150 000 operations. On the trot, with CasADi's default of one
+local variable per operation, ``-O1`` took 129 s of CPU and ``-O0`` 13 s
+(1.5 GB), but -O0's functions ran at half the speed of CasADi's virtual
+machine (45 against 24 ms of function CPU a solve, 22 iterations): a cached
+problem lost its saved build after three solves. With the work vector
+instead of locals (``avoid_stack``), ``-O1`` takes 38 s and 1.5 GB and runs
+as fast as the virtual machine (25 ms); -O0 then runs slower still (73 ms).
+The functions are about a tenth of an iteration (IPOPT and MUMPS are the
+rest), so compiling buys the build, not faster iterations."""
+
+_CODEGEN_OPTIONS = {"with_header": False, "avoid_stack": True}
 
 COMPILER_MEMORY_BYTES = 6 * 1024**3
 """gcc's address-space limit. With optimised phase durations TOWR's flat walk
@@ -105,7 +112,7 @@ def structure_digest(body: Any, terrain_key: tuple[Any, ...], schedule: Any, con
             default=repr,
         ),
         "casadi": ca.CasadiMeta.version(),
-        "flags": COMPILER_FLAGS,
+        "flags": (COMPILER_FLAGS, sorted(_CODEGEN_OPTIONS.items())),
         "source": _source_digest(),
     }
     text = json.dumps(description, sort_keys=True, default=repr)
@@ -220,7 +227,7 @@ def compile_and_store(
         raise CompileError(f"compiling this NLP failed before: {failed.read_text()[:500]}")
     tmp = Path(tempfile.mkdtemp(prefix=f"{key}.tmp-", dir=base))
     try:
-        generator = ca.CodeGenerator("nlp.c", {"with_header": False})
+        generator = ca.CodeGenerator("nlp.c", _CODEGEN_OPTIONS)
         for name, function in functions.items():
             if function.name() != name:
                 raise InvalidArgumentError(f"function '{function.name()}' stored as '{name}'")
