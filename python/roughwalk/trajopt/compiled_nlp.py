@@ -70,6 +70,10 @@ gives 20 MB of C whose compilation grew past 23 GB at -O0 until the kernel
 killed it (and could take other processes with it); capped, it fails alone and
 the NLP is built as expressions instead."""
 
+COMPILER_CPU_SECONDS = 240
+"""gcc's CPU limit [s]: the optimised-durations walk at -O1 was still compiling
+after 218 s of CPU (3.6 GB); such a problem is built as expressions instead."""
+
 _LIBRARY = "nlp.so"
 _FAILED = ".failed"
 _META = "meta.json"
@@ -190,11 +194,12 @@ def load(key: str, root: Path | None = None) -> CompiledNlp | None:
 
 
 class CompileError(InvalidArgumentError):
-    """The NLP could not be compiled (no gcc, or too large for its memory limit)."""
+    """The NLP could not be compiled (no gcc, or too large for its memory or CPU limit)."""
 
 
-def _limit_memory() -> None:
+def _limit_compiler() -> None:
     resource.setrlimit(resource.RLIMIT_AS, (COMPILER_MEMORY_BYTES, COMPILER_MEMORY_BYTES))
+    resource.setrlimit(resource.RLIMIT_CPU, (COMPILER_CPU_SECONDS, COMPILER_CPU_SECONDS))
 
 
 def _write_atomic(path: Path, text: str, directory: Path) -> None:
@@ -239,7 +244,7 @@ def compile_and_store(
                 cwd=tmp,
                 check=True,
                 capture_output=True,
-                preexec_fn=_limit_memory,
+                preexec_fn=_limit_compiler,
             )
         except (OSError, subprocess.CalledProcessError) as e:
             detail = (getattr(e, "stderr", b"") or b"").decode(errors="replace")[-500:]
