@@ -19,8 +19,12 @@ figures measured on this machine kind (issue 8; IPOPT 3.11.9 + MUMPS, exact
 Jacobians, L-BFGS Hessian, 40 s CPU limit, medians of 3 runs) are printed
 beside ours. The time limit is TOWR's 40 s. Wall times on a shared machine
 depend on its load, so the process CPU time of each solve is recorded too,
-and the cold run's CPU beyond a warm one's as the build CPU ("b. cpu"). Nothing
-is cached on disk: "cold" is a build from scratch.
+and the cold run's CPU beyond a warm one's as the build CPU ("b. cpu"). By
+default nothing is cached on disk: "cold" is a build from scratch. With
+``--compiled on`` the first process compiles each NLP to C (gcc's CPU, in a
+child process, is the "gcc" column) and stores it in the cache
+(``$ROUGHWALK_CACHE``); a second process loads it ("build" says
+expression, compiled or cached).
 
 CPU time is not a fixed cost on a shared machine either: what runs on the
 other core (or hyper-thread) slows this one. In session 8 the same commit's
@@ -36,6 +40,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import statistics
 import time
 from dataclasses import dataclass, field
@@ -111,20 +116,27 @@ def _finite(x: float) -> float | None:
     return x if math.isfinite(x) else None
 
 
-def run_case(case: Case, runs: int) -> dict[str, Any]:
+def run_case(case: Case, runs: int, compiled: str = "off") -> dict[str, Any]:
     """Solve ``case`` ``runs`` times (the first one builds); return its row."""
     config = (melon_config if case.family == "melon" else towr_config)(
-        body_model="towr_anymal", optimize_durations=case.optimize_durations
+        body_model="towr_anymal", optimize_durations=case.optimize_durations, compiled=compiled
     )
     results: list[TrajoptResult] = []
     cpu: list[float] = []
+    compile_cpu = 0.0
     for _ in range(runs):
+        before = os.times()
         start = time.process_time()
         r = optimize_motion(
             None, case.terrain, (case.start, case.goal), config=config, gait=case.gait,
             steps=case.steps, duration=case.duration, **case.options,
         )  # fmt: skip
         cpu.append(time.process_time() - start)
+        after = os.times()
+        # gcc runs as a child process (compiled="on", first run only).
+        compile_cpu += (after.children_user + after.children_system) - (
+            before.children_user + before.children_system
+        )
         results.append(r)
     cold = results[0]
     warm = results[1:] or results
@@ -145,6 +157,8 @@ def run_case(case: Case, runs: int) -> dict[str, Any]:
         "ms_per_iteration": 1000 * statistics.median(r.time_per_iteration_s for r in warm),
         "cold_total_s": cold.solve_time_s,
         "build_s": cold.build_time_s,
+        "build": cold.build,
+        "compile_cpu_s": compile_cpu,
         "warm_total_s": statistics.median(r.solve_time_s for r in warm),
         "cold_cpu_s": cpu[0],
         "warm_cpu_s": statistics.median(warm_cpu),
@@ -162,7 +176,8 @@ def print_table(rows: list[dict[str, Any]]) -> None:
     """The results, one line per task, TOWR's figure last."""
     head = (
         f"{'task':<44} {'status':<11} {'iter':>5} {'ms/it':>7} {'warm s':>7} {'cold s':>7} "
-        f"{'build s':>7} {'cpu w/c':>11} {'b. cpu':>6} {'vars':>5}  TOWR 1.4"
+        f"{'build s':>7} {'cpu w/c':>11} {'b. cpu':>6} {'gcc':>5} {'build':<10} {'vars':>5}  "
+        "TOWR 1.4"
     )
     family = None
     for row in rows:
@@ -176,6 +191,7 @@ def print_table(rows: list[dict[str, Any]]) -> None:
             f"{row['ms_per_iteration']:>7.1f} {row['warm_total_s']:>7.2f} "
             f"{row['cold_total_s']:>7.2f} {row['build_s']:>7.2f} "
             f"{row['warm_cpu_s']:>5.2f}/{row['cold_cpu_s']:<5.2f} {build_cpu:>6} "
+            f"{row['compile_cpu_s']:>5.1f} {row['build']:<10} "
             f"{row['n_variables']:>5}  "
             f"{row['towr']}"
         )
@@ -188,12 +204,25 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=3, help="solves per task (first one builds)")
     parser.add_argument("--family", choices=("melon", "towr"), help="only one family of tasks")
     parser.add_argument("--json", type=Path, default=RESULTS, help="where to write the results")
+    parser.add_argument(
+        "--compiled",
+        choices=("off", "on", "auto"),
+        default="off",
+        help="the NLP's functions from the compiled cache (see TrajoptConfig.compiled)",
+    )
+    parser.add_argument("--only", action="append", help="only the task of this name (repeatable)")
     args = parser.parse_args()
-    cases = [c for c in CASES if (c.quick or not args.quick) and args.family in (None, c.family)]
+    cases = [
+        c
+        for c in CASES
+        if (c.quick or not args.quick)
+        and args.family in (None, c.family)
+        and (not args.only or c.name in args.only)
+    ]
     rows = []
     for case in cases:
         clear_cache()
-        rows.append(run_case(case, max(args.runs, 1)))
+        rows.append(run_case(case, max(args.runs, 1), args.compiled))
         print(f"  {case.name}: {rows[-1]['status']}", flush=True)
     print_table(rows)
     write_json(

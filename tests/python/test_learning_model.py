@@ -194,8 +194,8 @@ def test_multipliers_of_a_constraint_added_after_training_start_at_zero() -> Non
 
     from roughwalk.learning.initializer import _complete_rows
 
-    rows = [SimpleNamespace(size=n) for n in (5, 3, 4)]
-    nlp = SimpleNamespace(rows=rows, n_constraints=12)
+    layout = [(name, n) for name, n in (("a", 5), ("b", 3), ("c", 4))]
+    nlp = SimpleNamespace(row_layout=layout, n_constraints=12)
     lam = np.arange(1.0, 9.0)  # the first two blocks: 8 rows
     completed = _complete_rows(nlp, lam)  # type: ignore[arg-type]
     np.testing.assert_array_equal(completed, np.concatenate([lam, np.zeros(4)]))

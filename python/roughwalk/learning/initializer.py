@@ -160,7 +160,7 @@ def _complete_rows(nlp: Formulation, lam_g: NDArray[np.float64]) -> NDArray[np.f
     n = lam_g.size
     if n >= nlp.n_constraints:
         return lam_g
-    ends = np.cumsum([rows.size for rows in nlp.rows])
+    ends = np.cumsum([size for _, size in nlp.row_layout])
     if n not in ends:
         return lam_g
     return np.concatenate([lam_g, np.zeros(nlp.n_constraints - n)])

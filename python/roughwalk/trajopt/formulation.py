@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from roughwalk.errors import InvalidArgumentError
+from roughwalk.trajopt.compiled_nlp import CompiledNlp
 from roughwalk.trajopt.constraints import Rows, make_constraint
 from roughwalk.trajopt.costs import CostTerm, make_costs
 from roughwalk.trajopt.gaits import ContactSchedule
@@ -233,6 +234,9 @@ class Formulation:
         The contact schedule (its total duration is T).
     terrain:
         The smooth terrain.
+    compiled:
+        The NLP's functions loaded from the cache (:mod:`.compiled_nlp`):
+        then no constraint or cost expression is built, only the variables.
 
     """
 
@@ -242,6 +246,7 @@ class Formulation:
         body: SingleRigidBody,
         schedule: ContactSchedule,
         terrain: TerrainModel,
+        compiled: CompiledNlp | None = None,
     ) -> None:
         if config.optimize_durations:
             # Optimised durations start inside their bounds (see ContactSchedule.fitted).
@@ -292,12 +297,66 @@ class Formulation:
         self._query_symbols: list[ca.SX] = []
 
         self.rows: list[Rows] = []
+        self.costs: list[CostTerm] = []
+        self.nlp: dict[str, Any] | ca.Function
+        self._hess_lag: ca.Function | None = None
+        self.lbx = np.concatenate([v.lower for v in self.variable_sets])
+        self.ubx = np.concatenate([v.upper for v in self.variable_sets])
+        if compiled is not None:
+            self._load(compiled)
+            return
         for name in config.constraints:
             rows = make_constraint(name).build(self)
             if rows is not None and rows.size:
                 self.rows.append(rows)
-        self.costs: list[CostTerm] = [c for c in make_costs(self) if c is not None]
+        self.costs = [c for c in make_costs(self) if c is not None]
+        self.row_layout = [(r.name, r.size) for r in self.rows]
+        self.cost_names = [c.name for c in self.costs]
         self._assemble()
+
+    def _load(self, compiled: CompiledNlp) -> None:
+        """Take the NLP's functions and row layout from the compiled library."""
+        if compiled.n_variables != self.n_variables:
+            raise InvalidArgumentError(
+                f"the compiled NLP has {compiled.n_variables} variables, "
+                f"this layout {self.n_variables}"
+            )
+        self.row_layout = list(compiled.row_layout)
+        self.cost_names = list(compiled.cost_names)
+        self.lbg, self.ubg = compiled.lbg, compiled.ubg
+        f = compiled.functions
+        self.nlp = f["nlp"]
+        self.evaluator = f["evaluate"]
+        self.jac_g = f["nlp_jac_g"]
+        self.grad_f = f["nlp_grad_f"]
+        self._hess_lag = f.get("nlp_hess_l")
+
+    def functions(self, hessian: bool) -> dict[str, ca.Function]:
+        """The functions IPOPT and the results call, by name, for :mod:`.compiled_nlp`."""
+        nlp = self.nlp
+        if isinstance(nlp, ca.Function):
+            raise InvalidArgumentError("this NLP was loaded compiled; it has no expressions")
+        out = {
+            "nlp": ca.Function(
+                "nlp", [nlp["x"], nlp["p"]], [nlp["f"], nlp["g"]], ["x", "p"], ["f", "g"]
+            ),
+            "nlp_jac_g": self.jac_g,
+            "nlp_grad_f": self.grad_f,
+            "evaluate": self.evaluator,
+        }
+        if hessian:
+            out["nlp_hess_l"] = self.hess_lag
+        return out
+
+    def layout(self) -> dict[str, Any]:
+        """Constraint bounds, row layout and cost names, for :mod:`.compiled_nlp`."""
+        return {
+            "lbg": self.lbg,
+            "ubg": self.ubg,
+            "row_layout": self.row_layout,
+            "cost_names": self.cost_names,
+            "n_variables": self.n_variables,
+        }
 
     # ------------------------------------------------------------------ parts' API
     @property
@@ -308,7 +367,7 @@ class Formulation:
     @property
     def n_constraints(self) -> int:
         """Number of constraint rows."""
-        return int(sum(r.size for r in self.rows))
+        return int(sum(size for _, size in self.row_layout))
 
     @property
     def n_feet(self) -> int:
@@ -371,8 +430,6 @@ class Formulation:
         f = ca.sum1(cost_vector) if self.costs else ca.SX(0)
         self.lbg = np.concatenate([r.lower for r in self.rows]) if self.rows else np.zeros(0)
         self.ubg = np.concatenate([r.upper for r in self.rows]) if self.rows else np.zeros(0)
-        self.lbx = np.concatenate([v.lower for v in self.variable_sets])
-        self.ubx = np.concatenate([v.upper for v in self.variable_sets])
 
         tq = ca.vertcat(*self._query_symbols) if self._query_symbols else ca.SX(0, 1)
         z = ca.vertcat(self.x, tq)
@@ -410,7 +467,7 @@ class Formulation:
         f_mx, g_mx, c_mx = values(x_mx, p_mx, t_mx)
         g_j, jx, jt = jac(x_mx, p_mx, t_mx)
         f_g, gx, gt = grad(x_mx, p_mx, t_mx)
-        self.nlp: dict[str, Any] = {"x": x_mx, "p": p_mx, "f": f_mx, "g": g_mx}
+        self.nlp = {"x": x_mx, "p": p_mx, "f": f_mx, "g": g_mx}
         self.evaluator = ca.Function("evaluate", [x_mx, p_mx], [f_mx, g_mx, c_mx])
         self.jac_g = ca.Function(
             "nlp_jac_g", [x_mx, p_mx], [g_j, jx + jt @ dt_dx], ["x", "p"], ["g", "jac_g_x"]
@@ -424,7 +481,6 @@ class Formulation:
             ["f", "grad_f_x"],
         )
         self._mx = (x_mx, p_mx, t_mx, dt_dx, tq, g, f)
-        self._hess_lag: ca.Function | None = None
 
     @property
     def hess_lag(self) -> ca.Function:
@@ -549,7 +605,7 @@ class Formulation:
     def row_slices(self) -> dict[str, slice]:
         """Where each constraint's rows sit in g."""
         out, start = {}, 0
-        for r in self.rows:
-            out[r.name] = slice(start, start + r.size)
-            start += r.size
+        for name, size in self.row_layout:
+            out[name] = slice(start, start + size)
+            start += size
         return out

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import time
+import warnings
 from collections import OrderedDict
 from collections.abc import Callable, Mapping
 from dataclasses import replace
@@ -22,13 +23,20 @@ from numpy.typing import NDArray
 from roughwalk.config import override, to_dict
 from roughwalk.errors import InvalidArgumentError
 from roughwalk.terrain import Terrain, load_terrain
+from roughwalk.trajopt import compiled_nlp
 from roughwalk.trajopt.formulation import Formulation
 from roughwalk.trajopt.gaits import ContactSchedule, make_gait
 from roughwalk.trajopt.initializers import Initializer, make_initializer
 from roughwalk.trajopt.parameters import TrajoptConfig, melon_config
 from roughwalk.trajopt.result import Splines, TrajoptResult
 from roughwalk.trajopt.robot_model import SingleRigidBody, rigid_body_model
-from roughwalk.trajopt.solver import IterationInfo, TrajoptSolver, TrajoptStatus, violation
+from roughwalk.trajopt.solver import (
+    IterationInfo,
+    TrajoptSolver,
+    TrajoptStatus,
+    hessian_choice,
+    violation,
+)
 from roughwalk.trajopt.task import Task, resolve, stance_problems
 from roughwalk.trajopt.terrain_model import TerrainModel
 from roughwalk.trajopt.variables import NumericSpline
@@ -79,10 +87,39 @@ class TrajoptProblem:
         self.terrain = terrain
         self.schedule = schedule
         self.config = config
-        self.formulation = Formulation(config, body, schedule, terrain)
+        self.build = "expression"
+        """How the NLP's functions were made: "expression" (CasADi graphs built
+        here), "compiled" (built, compiled to C and stored: the build time
+        includes gcc's) or "cached" (loaded from a compiled library)."""
+        self.formulation = self._formulation()
         self.solver = TrajoptSolver(self.formulation, config.solver)
         self.build_time_s = time.perf_counter() - start
         self._build_pending = True
+
+    def _formulation(self) -> Formulation:
+        """The NLP: from the compiled cache when the config allows (``compiled``)."""
+        cfg, body, schedule, terrain = self.config, self.body, self.schedule, self.terrain
+        if cfg.compiled == "off":
+            return Formulation(cfg, body, schedule, terrain)
+        key = compiled_nlp.structure_digest(body, _terrain_key(terrain.terrain), schedule, cfg)
+        loaded = compiled_nlp.load(key)
+        if loaded is None and cfg.compiled == "on":
+            built = Formulation(cfg, body, schedule, terrain)
+            exact = hessian_choice(cfg.solver, bool(built.cost_names)) == "exact"
+            try:
+                compiled_nlp.compile_and_store(key, built.functions(exact), built.layout())
+            except compiled_nlp.CompileError as e:
+                warnings.warn(f"{e}; solving with CasADi's expressions", stacklevel=3)
+                return built
+            loaded = compiled_nlp.load(key)
+            if loaded is None:
+                return built
+            self.build = "compiled"
+        elif loaded is None:
+            return Formulation(cfg, body, schedule, terrain)
+        else:
+            self.build = "cached"
+        return Formulation(cfg, body, schedule, terrain, compiled=loaded)
 
     @property
     def n_variables(self) -> int:
@@ -165,6 +202,7 @@ class TrajoptProblem:
             iterations=outcome.iterations,
             solve_time_s=outcome.solve_time_s + build + extra,
             build_time_s=build,
+            build=self.build,
             objective=outcome.objective,
             max_violation=max_violation,
             max_force_n=float(np.linalg.norm(forces, axis=2).max()),
@@ -175,7 +213,7 @@ class TrajoptProblem:
             body=self.body,
             schedule=schedule,
             splines=splines,
-            costs={c.name: float(v) for c, v in zip(nlp.costs, outcome.costs, strict=True)},
+            costs={c: float(v) for c, v in zip(nlp.cost_names, outcome.costs, strict=True)},
             violations=per_row,
             return_status=outcome.return_status,
             history=outcome.history,
@@ -394,6 +432,7 @@ def optimize_motion(
         schedule.in_contact_at_start,
         schedule.name,
         cfg.structure_key(),
+        cfg.compiled,
     )
     problem, _ = _cached(_problems, key, lambda: TrajoptProblem(body, terrain_model, schedule, cfg))
     elapsed = (

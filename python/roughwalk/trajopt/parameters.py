@@ -54,6 +54,7 @@ MELON_CONSTRAINTS: tuple[str, ...] = (
 """TOWR's constraints plus Melon et al.'s base-above-feet and swing-height ones and a swing apex."""
 
 MELON_REACH_CONSTRAINTS: tuple[str, ...] = (*MELON_CONSTRAINTS, "leg_reach")
+_COMPILED_MODES = ("off", "on", "auto")
 """:data:`MELON_CONSTRAINTS` plus the legs' real reach (a ball per leg, for bodies that know it).
 
 The default set of :func:`melon_config`: plans made with it keep every
@@ -391,6 +392,13 @@ class TrajoptConfig:
         IPOPT settings and limits (:class:`SolverOptions`).
     sample_rate_hz:
         Rate [Hz] at which results sample the trajectories for JSON output.
+    compiled:
+        Where the NLP's functions come from (:mod:`.compiled_nlp`): "off"
+        builds CasADi expressions in every process; "on" loads them compiled
+        from the on-disk cache, or builds, compiles (gcc: seconds to minutes
+        for a large problem) and stores them; "auto" loads them when cached
+        and otherwise builds expressions without compiling. A cache hit
+        skips 0.3–1 s of building; the solve is the same.
 
     """
 
@@ -413,8 +421,13 @@ class TrajoptConfig:
     terrain: TerrainModelConfig = field(default_factory=TerrainModelConfig)
     solver: SolverOptions = field(default_factory=SolverOptions)
     sample_rate_hz: float = 100.0
+    compiled: str = "off"
 
     def __post_init__(self) -> None:
+        if self.compiled not in _COMPILED_MODES:
+            raise ConfigError(
+                f"compiled must be one of {', '.join(_COMPILED_MODES)}, got {self.compiled!r}"
+            )
         lo, hi = self.phase_duration_bounds
         if not 0 < lo < hi:
             raise ConfigError(

@@ -96,6 +96,10 @@ class TrajoptResult:
         Wall time [s] from task to solution, including any building that was not reused.
     build_time_s:
         Of which building the NLP and solver [s] (0 when reused).
+    build:
+        How the NLP's functions were made: "expression" (CasADi graphs),
+        "compiled" (graphs compiled to C and cached; the build time includes
+        the compiler's) or "cached" (loaded from the cache).
     objective:
         Objective value (0 for TOWR's feasibility problem).
     max_violation:
@@ -134,6 +138,7 @@ class TrajoptResult:
     iterations: int = 0
     solve_time_s: float = 0.0
     build_time_s: float = 0.0
+    build: str = "expression"
     objective: float = float("nan")
     max_violation: float = float("inf")
     max_force_n: float = float("nan")
@@ -233,6 +238,7 @@ class TrajoptResult:
             "iterations": self.iterations,
             "solve_time_s": self.solve_time_s,
             "build_time_s": self.build_time_s,
+            "build": self.build,
             "time_per_iteration_s": self.time_per_iteration_s,
             "objective": _finite(self.objective),
             "max_violation": _finite(self.max_violation),
@@ -321,6 +327,7 @@ class TrajoptResult:
                 iterations=int(data.get("iterations", 0)),
                 solve_time_s=float(data.get("solve_time_s", 0.0)),
                 build_time_s=float(data.get("build_time_s", 0.0)),
+                build=str(data.get("build", "expression")),
                 objective=float(data.get("objective") or math.nan),
                 max_violation=float(data.get("max_violation") or 0.0),
                 max_force_n=float(data.get("max_force_n") or math.nan),

@@ -31,7 +31,7 @@ from roughwalk.errors import InvalidArgumentError
 from roughwalk.trajopt.formulation import Formulation
 from roughwalk.trajopt.parameters import SolverOptions
 
-__all__ = ["TrajoptStatus", "IterationInfo", "SolveOutcome", "TrajoptSolver"]
+__all__ = ["TrajoptStatus", "IterationInfo", "SolveOutcome", "TrajoptSolver", "hessian_choice"]
 
 
 class TrajoptStatus(enum.Enum):
@@ -154,6 +154,13 @@ def _single_threaded_blas() -> bool:
     return True
 
 
+def hessian_choice(options: SolverOptions, has_costs: bool) -> str:
+    """IPOPT's Hessian: the options' choice; "auto" is exact with costs, L-BFGS without."""
+    if options.hessian == "auto":
+        return "exact" if has_costs else "limited-memory"
+    return options.hessian
+
+
 class _Monitor(ca.Callback):
     """IPOPT's intermediate callback: limits, history and the user's callback."""
 
@@ -245,9 +252,7 @@ class TrajoptSolver:
         o = self.options
         _single_threaded_blas()
         fixed = not nlp.config.optimize_durations
-        self.hessian = o.hessian
-        if o.hessian == "auto":
-            self.hessian = "exact" if nlp.costs else "limited-memory"
+        self.hessian = hessian_choice(o, bool(nlp.cost_names))
         pivot_order = o.mumps_pivot_order
         if pivot_order is None:
             # See SolverOptions.mumps_pivot_order: AMD with the exact Hessian.
