@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import roughwalk
-from roughwalk.sim.recovery import centred_fit, recovery_segment
+from roughwalk.sim.recovery import centred_fit, off_edge, recovery_segment
 from roughwalk.sim.runner import Runner
 from roughwalk.sim.world import World
 from roughwalk.trajectories.body_keyframes import nominal_fit
@@ -61,6 +61,48 @@ def test_a_trunk_heading_for_the_lifted_foot_moves_it_to_the_capture_point(stand
     # Capture off: straight down.
     off = footholds(standing, [0.0, 0.2, 0.0], capture_max_m=0.0)
     np.testing.assert_allclose(off[2, :2], measured.feet[2, :2], atol=1e-12)
+
+
+def test_a_foot_caught_over_a_steps_edge_goes_down_on_the_step_not_on_its_corner(standing) -> None:
+    """The steps course, seed 1 of ``bench littledog --classes steps --expansions 40000``.
+
+    The foot-force reflex fired at 8.36 s while RF swung up to the 10.8 cm
+    step, RF 2.5 mm past the step's edge (x ≈ 0.695): straight down, it
+    stood on the corner, slipped, and the robot rolled over.
+    """
+    robot, _, measured = standing
+    steps = roughwalk.load_terrain("steps")
+    at_reflex = dataclasses.replace(
+        measured,
+        base_pos=np.array([0.5877, 0.01332, 0.18383]),
+        base_quat=np.array([0.98816, -0.10751, -0.1049, 0.0313]),
+        base_vel=np.array([0.0073, 0.0175, 0.0117]),
+        feet=np.array(
+            [
+                [0.68546, 0.06994, 0.06427],
+                [0.69777, -0.05661, 0.14315],
+                [0.49034, 0.07059, 0.01086],
+                [0.51873, -0.04215, 0.0102],
+            ]
+        ),
+    )
+    planned = at_reflex.feet.copy()
+    planned[1] = [0.7474, -0.05255, 0.108 + robot.foot_radius]
+    planned[2] = [0.4949, 0.05855, robot.foot_radius]
+    down = np.array([True, False, False, True])
+    _, feet = recovery_segment(
+        robot, steps, at_reflex, planned, down, 0.5, 0.3, 0.0, capture_max_m=0.04
+    )
+    r = robot.foot_radius
+    under = feet[1, :2] + 0.5 * r * np.array([[0, 0], [1, 0], [-1, 0], [0, 1], [0, -1]])
+    ground = steps.height(under)
+    np.testing.assert_allclose(ground, 0.108, atol=1e-9)  # all of it on the step
+    assert 0.0 < feet[1, 0] - at_reflex.feet[1, 0] <= 0.02  # towards its foothold, a little
+    # LH, slid 1.3 cm off its foothold on flat ground, goes back onto it.
+    np.testing.assert_allclose(feet[2, :2], planned[2, :2], atol=1e-12)
+    # With no flat ground within reach, the catch stays.
+    corner = off_edge(steps, at_reflex.feet[1], planned[1], r, 0.0)
+    np.testing.assert_allclose(corner, at_reflex.feet[1])
 
 
 def test_the_trunk_settles_with_its_centre_of_mass_over_the_feet_on_a_tilted_stance() -> None:

@@ -5,7 +5,8 @@ all four feet firmly on the ground". :func:`recovery_segment` does it in
 three parts, from the measured state:
 
 1. every foot off the ground goes down, fast: straight below where it is
-   (to its planned foothold if that is within 2 cm); the trunk holds still.
+   (to its planned foothold if that is within 2 cm; towards it, off a step's
+   edge, :func:`off_edge`); the trunk holds still.
    A trunk moving towards a lifted foot's side (a push) moves that foot's
    target by the capture offset v·√(h/g) (the linear inverted pendulum's
    capture point), so the support polygon reaches where the trunk is going;
@@ -43,10 +44,21 @@ __all__ = [
     "blend_segment",
     "pose_segment",
     "min_jerk",
+    "off_edge",
 ]
 
 _RATE_HZ = 100.0
 _GRAVITY = 9.81
+EDGE_RISE_M = 0.01
+"""Height change [m] of the ground under a foot (half its radius either side
+of its centre, about one radius across) beyond which a lowered foot stands on
+an edge: LittleDog's 1 cm across is steeper than 45°, where no foot holds
+with μ = 1. At 0.5 cm, a catch on a rock's flank (board AC, seed 0 of the
+bench's round rocks: 5.6 mm) moved too, and that run fell."""
+EDGE_STEP_M = 0.0025
+"""Step [m] of :func:`off_edge`'s search towards the planned foothold."""
+EDGE_REACH_M = 0.02
+"""Farthest [m] :func:`off_edge` moves a lowered foot."""
 
 
 def min_jerk(s: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -233,6 +245,43 @@ def centred_fit(
     return fit, rpy
 
 
+def off_edge(
+    terrain: Terrain,
+    catch: NDArray[np.float64],
+    toward: NDArray[np.float64],
+    foot_radius: float,
+    reach: float,
+) -> NDArray[np.float64]:
+    """A lowered foot's catch (3,) [m] moved off a step's edge, towards ``toward`` (3,).
+
+    A foot put down where the ground under it changes height (a step's
+    corner: within half a foot radius of the foot's centre by more than
+    :data:`EDGE_RISE_M`) rolls off the corner as it presses. A swing
+    caught just over a step's edge did so on the LittleDog steps course
+    (seed 1 of ``bench littledog --classes steps --expansions 40000``): RF
+    went down 2 mm past the 5.4 cm step's edge, onto the corner, slipped,
+    and the robot rolled over. The catch moves on towards where the foot
+    was headed (its planned foothold, on ground the planner accepted),
+    2.5 mm at a time up to ``reach`` [m], to the first flat ground; if
+    there is none, it stays.
+    """
+    start = np.asarray(catch, dtype=float)
+    way = np.asarray(toward, dtype=float)[:2] - start[:2]
+    length = float(np.linalg.norm(way))
+    ring = (
+        0.5 * foot_radius * np.array([[0.0, 0.0], [1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
+    )
+    steps = int(np.floor(min(reach, length) / EDGE_STEP_M + 1e-9))
+    for k in range(steps + 1):
+        xy = start[:2] + (k * EDGE_STEP_M / length) * way if k else start[:2]
+        z = np.asarray(terrain.height(xy[None] + ring), dtype=float)
+        if float(np.ptp(z)) <= EDGE_RISE_M:
+            out = start.copy()
+            out[:2] = xy
+            return out
+    return start
+
+
 def recovery_segment(
     robot: Robot,
     terrain: Terrain,
@@ -278,9 +327,10 @@ def recovery_segment(
         catch = start_feet[leg].copy()
         if float(capture @ (start_feet[leg, :2] - centre)) > 0.0:
             catch[:2] += capture
-        goal = np.asarray(planned_feet[leg], dtype=float).copy()
+        planned = np.asarray(planned_feet[leg], dtype=float)
+        goal = planned.copy()
         if np.linalg.norm(goal[:2] - catch[:2]) > 0.02:
-            goal = catch
+            goal = off_edge(terrain, catch, planned, r, EDGE_REACH_M)
         # "Firmly on the ground": aim a little into it, so the servo presses
         # the foot down and the pressing legs stop the trunk tipping.
         goal[2] = float(terrain.height(goal[None, :2])[0]) + r - press_m
