@@ -34,6 +34,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from roughwalk.cli.common import machine_description, result_envelope, write_json
 
 RESULTS = Path(__file__).resolve().parent / "results" / "tracking.json"
@@ -232,6 +234,7 @@ def run_job(job: Job) -> dict[str, Any]:
     if result.splines is None:
         row.update(success=False, reason="no trajectory")
         return row
+    row.update(pyramid_violation_n=pyramid_violation(result))
     try:
         from roughwalk.tracking import TrackingConfig
 
@@ -254,6 +257,21 @@ def run_job(job: Job) -> dict[str, Any]:
         cpu_s=time.process_time() - started_cpu,
     )
     return row
+
+
+def pyramid_violation(result: Any, margin_s: float = 0.3, rate_hz: float = 200.0) -> float:
+    """Largest max(|f_x| − μ f_z, |f_y| − μ f_z, −f_z) [N] of a stance foot's planned force.
+
+    Sampled every 1/``rate_hz`` [s] between ``margin_s`` and T − ``margin_s``
+    [s], so between the force nodes too, where the node rows do not look;
+    the upright pyramid (the pallet tops are flat). μ is the body's.
+    """
+    plan = result.sample(rate_hz)
+    keep = (plan["t"] >= margin_s) & (plan["t"] <= result.duration - margin_s)
+    f = plan["forces"][keep]
+    mu = result.body.friction
+    excess = np.maximum(np.abs(f[..., :2]).max(axis=-1) - mu * f[..., 2], -f[..., 2])
+    return float(np.where(plan["contact"][keep], excess, -np.inf).max(initial=0.0))
 
 
 def _finite(x: float) -> float | None:
@@ -280,6 +298,7 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
             r["mean_position_error_m"] for r in rs if r.get("mean_position_error_m") is not None
         ]
         ticks = [r["tick_cpu_ms"] for r in rs if r.get("tick_cpu_ms") is not None]
+        pyramid = [r["pyramid_violation_n"] for r in rs if r.get("pyramid_violation_n") is not None]
         out.append(
             {
                 "env": env,
@@ -292,6 +311,7 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 "mean_tick_cpu_ms": sum(ticks) / len(ticks) if ticks else None,
                 "solved_rate": sum(r.get("solve_status") in ("exact", "acceptable") for r in rs)
                 / len(rs),
+                "median_pyramid_violation_n": float(np.median(pyramid)) if pyramid else None,
             }
         )
     return out
@@ -358,25 +378,38 @@ def _tracking_settings(text: str) -> tuple[tuple[str, Any], ...]:
 
 def _trajopt_settings(text: str) -> tuple[tuple[str, Any], ...]:
     """``NAME=VALUE,...`` as TrajoptConfig fields (true/false, numbers), checked by name."""
-    from roughwalk.trajopt import TrajoptConfig
+    from roughwalk.trajopt import TrajoptConfig, melon_config
 
-    return _settings(text, TrajoptConfig, "--trajopt")
+    return _settings(text, TrajoptConfig, "--trajopt", melon_config())
 
 
-def _settings(text: str, cls: type, option: str) -> tuple[tuple[str, Any], ...]:
-    """``NAME=VALUE,...`` as fields of the dataclass ``cls`` (true/false, numbers)."""
+def _settings(
+    text: str, cls: type, option: str, defaults: Any = None
+) -> tuple[tuple[str, Any], ...]:
+    """``NAME=VALUE,...`` as fields of the dataclass ``cls`` (true/false, numbers).
+
+    A dotted ``NAME.FIELD`` changes one field of a nested config, starting
+    from ``defaults``' (or ``cls()``'s) value of it.
+    """
     import dataclasses
 
     names = {f.name for f in dataclasses.fields(cls)}
-    out = []
+    out: dict[str, Any] = {}
     for item in filter(None, (v.strip() for v in text.split(","))):
         name, _, value = item.partition("=")
-        if name not in names:
-            raise SystemExit(f"{option}: {cls.__name__} has no field {name!r}")
+        # A dotted name sets a field of a nested config: costs.force_between_nodes_penalty=10.
+        head, _, rest = name.partition(".")
+        if head not in names:
+            raise SystemExit(f"{option}: {cls.__name__} has no field {head!r}")
         low = value.lower()
         parsed: Any = low == "true" if low in ("true", "false") else float(value)
-        out.append((name, parsed))
-    return tuple(out)
+        if rest:
+            nested = out.get(head, getattr(defaults or cls(), head))
+            if rest not in {f.name for f in dataclasses.fields(nested)}:
+                raise SystemExit(f"{option}: {type(nested).__name__} has no field {rest!r}")
+            parsed = dataclasses.replace(nested, **{rest: parsed})
+        out[head] = parsed
+    return tuple(out.items())
 
 
 def main() -> None:

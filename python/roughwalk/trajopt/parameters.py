@@ -117,6 +117,11 @@ class CostWeights:
     swing_height:
         Weight [1/m²] on (apex height − mean height of the two footholds)²:
         keeps steps low (the swing-height constraint keeps them high enough).
+    force_between_nodes_penalty:
+        Weight of the squared violation of the friction pyramid and force
+        bounds at the force segments' inner control points, divided by m·g
+        (:mod:`~roughwalk.trajopt.costs.force_between_nodes_penalty`): the
+        soft form of the ``force_between_nodes`` rows. 0 (off) by default.
 
     """
 
@@ -127,12 +132,14 @@ class CostWeights:
     step_edge: float = 1.0
     step_edge_sigma: float = 0.05
     swing_height: float = 5.0
+    force_between_nodes_penalty: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.step_edge < 0 or self.swing_height < 0:
+        if self.step_edge < 0 or self.swing_height < 0 or self.force_between_nodes_penalty < 0:
             raise ConfigError(
                 f"cost weights must be ≥ 0, got step_edge={self.step_edge}, "
-                f"swing_height={self.swing_height}"
+                f"swing_height={self.swing_height}, "
+                f"force_between_nodes_penalty={self.force_between_nodes_penalty}"
             )
         if not self.step_edge_sigma > 0:
             raise ConfigError(f"step_edge_sigma must be > 0 m, got {self.step_edge_sigma}")
