@@ -251,7 +251,7 @@ def test_towr_block_goal_with_hind_feet_at_the_edge_solves() -> None:
     # Goal 0.95 m: the level goal base needs the hind feet up on the block
     # (edge at 0.7 m, hind reach 0.61 + 0.15 m). From the nominal goal stance
     # (hind feet on the ground, 0.5 m below the front ones) IPOPT hit its
-    # 40 s limit after ~1500 iterations; from a level goal stance it takes 26.
+    # 40 s limit after ~1500 iterations; from a level goal stance it takes 47.
     from dataclasses import replace
 
     config = towr_config()
