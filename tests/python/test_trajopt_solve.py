@@ -351,6 +351,8 @@ SMALL = {"config": towr_config(), "gait": "walk", "steps": 4, "duration": 2.0}
         ("flat", ((float("nan"), 0.0, 0.0), (1.0, 0.0, 0.0)), {}, "not finite"),
         ("flat", ((0.0, 0.0, 0.0), (1.0, float("inf"), 0.0)), {}, "not finite"),
         ("towr_block:height=1.0", ((0.0, 0.0, 0.0), (0.7, 0.0, 0.0)), {}, "inside an obstacle"),
+        # Hind feet reach x ≤ 0.71 m (0.2 m up the edge), front feet 0.5 m up: no level goal.
+        ("towr_block", ((0.0, 0.0, 0.0), (0.9, 0.0, 0.0)), {}, "no level base"),
         ("flat", ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)), {"duration": 0.2}, "too short"),
         (
             "flat",
