@@ -247,6 +247,27 @@ def test_towr_block_solves_unscaled_in_fewer_iterations_than_scaled() -> None:
     assert unscaled_result.iterations < 0.6 * scaled_result.iterations
 
 
+def test_towr_block_goal_with_hind_feet_at_the_edge_solves() -> None:
+    # Goal 0.95 m: the level goal base needs the hind feet up on the block
+    # (edge at 0.7 m, hind reach 0.61 + 0.15 m). From the nominal goal stance
+    # (hind feet on the ground, 0.5 m below the front ones) IPOPT hit its
+    # 40 s limit after ~1500 iterations; from a level goal stance it takes 47.
+    from dataclasses import replace
+
+    config = towr_config()
+    task = ((0.0, 0.0, 0.0), (0.95, 0.0, 0.0))
+    kwargs = {"gait": "walk", "steps": 16, "duration": 3.5}
+    guess_only = replace(config, solver=replace(config.solver, max_iter=0))
+    guess = optimize_motion(None, "towr_block", task, config=guess_only, **kwargs)
+    assert guess.splines is not None
+    goal_heights = [float(foot.positions[-1, 2]) for foot in guess.splines.feet]
+    assert max(goal_heights) - min(goal_heights) <= 0.2  # 2·Δz of TOWR's ANYmal
+    limited = replace(config, solver=replace(config.solver, max_iter=150))
+    result = optimize_motion(None, "towr_block", task, config=limited, **kwargs)
+    assert result.solved, result.status
+    assert result.max_violation <= config.solver.constr_viol_tol
+
+
 class _GuessWithMultipliers:
     """An initialiser handing over a given guess and multipliers (as the learned one does)."""
 
@@ -330,6 +351,8 @@ SMALL = {"config": towr_config(), "gait": "walk", "steps": 4, "duration": 2.0}
         ("flat", ((float("nan"), 0.0, 0.0), (1.0, 0.0, 0.0)), {}, "not finite"),
         ("flat", ((0.0, 0.0, 0.0), (1.0, float("inf"), 0.0)), {}, "not finite"),
         ("towr_block:height=1.0", ((0.0, 0.0, 0.0), (0.7, 0.0, 0.0)), {}, "inside an obstacle"),
+        # Hind feet reach x ≤ 0.71 m (0.2 m up the edge), front feet 0.5 m up: no level goal.
+        ("towr_block", ((0.0, 0.0, 0.0), (0.9, 0.0, 0.0)), {}, "no level base"),
         ("flat", ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)), {"duration": 0.2}, "too short"),
         (
             "flat",

@@ -37,7 +37,7 @@ from roughwalk.trajopt.solver import (
     hessian_choice,
     violation,
 )
-from roughwalk.trajopt.task import Task, resolve, stance_problems
+from roughwalk.trajopt.task import Task, level_stance_problems, resolve, stance_problems
 from roughwalk.trajopt.terrain_model import TerrainModel
 from roughwalk.trajopt.variables import NumericSpline
 
@@ -416,6 +416,8 @@ def optimize_motion(
     problems = _schedule_problems(schedule, cfg)
     problems += stance_problems(body, terrain_model, the_task.start, "start")
     problems += stance_problems(body, terrain_model, the_task.goal, "goal")
+    if not problems and {"goal_state", "range_of_motion"} <= set(cfg.constraints):
+        problems += level_stance_problems(body, terrain_model, the_task.goal, "goal")
     if problems:
         return _invalid(
             the_task,

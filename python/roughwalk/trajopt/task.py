@@ -24,7 +24,7 @@ from roughwalk.trajopt.robot_model import SingleRigidBody
 from roughwalk.trajopt.terrain_model import TerrainModel
 from roughwalk.trajopt.variables.base_angular import euler_to_rotation
 
-__all__ = ["Task", "ResolvedTask", "TASK_SIZE", "parse_pose"]
+__all__ = ["Task", "ResolvedTask", "TASK_SIZE", "parse_pose", "level_stance_problems"]
 
 # p = [start pos (3), start euler (3), start feet (12), goal xy (2), goal euler (3), goal z (1)]
 TASK_SIZE = 24
@@ -197,3 +197,41 @@ def stance_problems(
             f"sloping {np.degrees(np.arctan(slope)):.0f}° (at most 45°)"
         )
     return out
+
+
+_LEVEL_SAMPLE = 0.01  # [m] spacing of the ground samples in a foot's reach
+_LEVEL_TOLERANCE = 0.02  # [m] slack for ground between the samples
+
+
+def level_stance_problems(
+    body: SingleRigidBody, terrain: TerrainModel, pose: tuple[float, float, float], what: str
+) -> list[str]:
+    """Say why no level base at ``pose`` can stand: its feet reach no common ground level.
+
+    The goal base is level (roll and pitch zero) and each foot must stand in
+    its range-of-motion box around the nominal foothold (±Δx, ±Δy, ±Δz in the
+    base frame), so some height window 2Δz high must hold ground within every
+    foot's x-y reach. TOWR's block 0.9 m is such a goal: the hind feet reach
+    x ≤ 0.71 m, where the smoothed edge is 0.2 m high, under front feet 0.5 m
+    up on the block; IPOPT ran into its 40 s limit there.
+    """
+    x, y, yaw = pose
+    rot = euler_to_rotation(np.array([0.0, 0.0, yaw]))
+    dx, dy, dz = body.max_deviation
+    ox = np.linspace(-dx, dx, 2 * math.ceil(dx / _LEVEL_SAMPLE) + 1)
+    oy = np.linspace(-dy, dy, 2 * math.ceil(dy / _LEVEL_SAMPLE) + 1)
+    offsets = np.array(np.meshgrid(ox, oy, indexing="ij")).reshape(2, -1).T
+    local = body.stance[:, None, :2] + offsets[None, :, :]  # (4, m, 2) in the base frame
+    points = np.array([x, y]) + local @ rot[:2, :2].T
+    heights = terrain.height(points.reshape(-1, 2)).reshape(len(body.stance), -1)
+    window = 2 * dz + _LEVEL_TOLERANCE
+    levels = np.unique(np.floor(heights * 1000) / 1000)  # each sample lies in its own window
+    inside = (heights[None, :, :] >= levels[:, None, None]) & (
+        heights[None, :, :] <= levels[:, None, None] + window
+    )
+    if np.any(np.all(np.any(inside, axis=2), axis=1)):
+        return []
+    return [
+        f"{what} ({x:g}, {y:g}): no level base can stand there: its feet's reach holds no "
+        f"ground within {2 * dz:.2f} m of one height (the range-of-motion box)"
+    ]

@@ -16,6 +16,7 @@ __all__ = [
     "forces_guess",
     "pack_guess",
     "off_edges",
+    "level_goal_stance",
 ]
 
 _FLAT_SLOPE = 0.3  # steeper ground than this is no place for a guessed foothold
@@ -38,13 +39,20 @@ def poly_durations(
 
 
 def straight_base(
-    nlp: Formulation, task: ResolvedTask, times: NDArray[np.float64]
+    nlp: Formulation,
+    task: ResolvedTask,
+    times: NDArray[np.float64],
+    goal_z: float | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """CoM positions (n, 3) and Euler angles (n, 3) on the straight line from start to goal.
 
     The height follows the terrain under the nominal feet at each pose, and
     the base pitches and rolls with the plane through them, so that a guess
-    over a pallet climbs it with the feet within their reach.
+    over a pallet climbs it with the feet within their reach. ``goal_z`` [m]
+    (the CoM height over guessed goal footholds) shifts the heights towards
+    it over the last quarter of the way, when the feet take their last
+    steps to those footholds (spread over the whole way, the block 0.95 m
+    took 347 iterations instead of 26).
     """
     schedule = nlp.schedule
     first_lift = min(schedule.durations[f][0] for f in range(schedule.n_feet))
@@ -67,6 +75,8 @@ def straight_base(
         _, gx, gy = np.linalg.lstsq(design, feet[:, 2], rcond=None)[0]
         pitch[i] = -np.arctan(gx)
         roll[i] = np.arctan(gy)
+    if goal_z is not None:
+        z += np.clip(4 * s[:, 0] - 3, 0, 1) * (goal_z - z[-1])
     z[0] = task.base_position[2]
     roll[0] = pitch[0] = roll[-1] = pitch[-1] = 0.0
     positions = np.column_stack([xy, z])
@@ -95,6 +105,52 @@ def off_edges(
     good = np.flatnonzero((slope < _FLAT_SLOPE) & (values[:, 3] < _EDGE_COST))
     best = int(good[0]) if good.size else 0
     return np.array([points[best, 0], points[best, 1], values[best, 0]])
+
+
+def level_goal_stance(
+    nlp: Formulation, feet: NDArray[np.float64], direction: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Goal footholds (4, 3) [m] moved along ``direction`` (2,) so that a level base reaches them.
+
+    The goal's base is level (TOWR's goal orientation), so its feet must
+    stand within the range-of-motion box's height 2·Δz of one another. The
+    nominal stance astride a step does not (block 1.0 m: hind feet on the
+    ground, front feet 0.5 m up on the block) and the solver spends hundreds
+    of iterations leaving that guess. For each level c (a nominal foothold's
+    height, or ±Δz from it) every foot takes, within its x reach, ground
+    whose height lies within Δz of c: the nearest flat ground off edges, or
+    else the least steep; the level that leaves the fewest feet without
+    such ground and moves them least wins. Feet already level stay put.
+    """
+    reach, dz = nlp.body.max_deviation[0], nlp.body.max_deviation[2]
+    if np.ptp(feet[:, 2]) <= 2 * dz:
+        return feet
+    offsets = np.linspace(-reach, reach, 31)
+    unit = np.asarray(direction, dtype=float) / max(float(np.linalg.norm(direction)), 1e-9)
+    points = feet[:, None, :2] + offsets[None, :, None] * unit[None, None, :]
+    values = nlp.terrain.evaluate(points.reshape(-1, 2)).reshape(len(feet), len(offsets), 4)
+    heights = values[:, :, 0]
+    slope = np.hypot(values[:, :, 1], values[:, :, 2])
+    good = (slope < _FLAT_SLOPE) & (values[:, :, 3] < _EDGE_COST)
+    best: tuple[tuple[int, float], NDArray[np.float64]] | None = None
+    for level in np.unique(np.concatenate([feet[:, 2] - dz, feet[:, 2], feet[:, 2] + dz])):
+        chosen = feet.copy()
+        missing, moved = 0, 0.0
+        for foot in range(len(feet)):
+            inside = np.abs(heights[foot] - level) <= dz
+            if not inside.any():
+                missing += 1
+                continue
+            # Flat ground off edges first, nearest; otherwise the least steep.
+            key = np.where(good[foot], np.abs(offsets), 10.0 + slope[foot])
+            k = int(np.argmin(np.where(inside, key, np.inf)))
+            chosen[foot] = [*points[foot, k], heights[foot, k]]
+            moved += abs(float(offsets[k]))
+        score = (missing, moved)
+        if best is None or score < best[0]:
+            best = (score, chosen)
+    assert best is not None
+    return best[1]
 
 
 def finite_difference(
