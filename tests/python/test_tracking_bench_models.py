@@ -2,30 +2,18 @@
 
 from __future__ import annotations
 
-import importlib.util
 import shutil
-import sys
 from pathlib import Path
-from types import ModuleType
 
 import pytest
+from _benchmarks import load_benchmark
 
 pytest.importorskip("roughwalk.learning")
 
 from roughwalk.learning.initializer import MODELS_DIR  # noqa: E402
 from roughwalk.trajopt.parameters import MELON_REACH_CONSTRAINTS  # noqa: E402
 
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_tracking.py"
 DOUBLE = MODELS_DIR / "anymal_c_double_pallet_walk16.npz"
-
-
-def _bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_tracking", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
 
 
 @pytest.fixture
@@ -36,12 +24,12 @@ def candidate(tmp_path: Path) -> Path:
 
 
 def test_without_a_folder_the_shipped_model_is_used() -> None:
-    bench = _bench()
+    bench = load_benchmark("bench_tracking")
     assert bench.learned_init("double_pallet", False, None) == "learned"
 
 
 def test_the_folder_s_model_that_fits_the_problem_is_used(candidate: Path) -> None:
-    bench = _bench()
+    bench = load_benchmark("bench_tracking")
     init = bench.learned_init("double_pallet", False, candidate)
     assert init == f"learned:{candidate / 'candidate.npz'}"
     assert bench.learned_model_for("double_pallet", False, init) == ""
@@ -50,7 +38,7 @@ def test_the_folder_s_model_that_fits_the_problem_is_used(candidate: Path) -> No
 
 
 def test_a_folder_without_a_fitting_model_is_reported_not_replaced(candidate: Path) -> None:
-    bench = _bench()
+    bench = load_benchmark("bench_tracking")
     init = bench.learned_init("single_pallet", False, candidate)
     assert init == f"learned:{candidate}"
     assert bench.learned_model_for("single_pallet", False, init) != ""

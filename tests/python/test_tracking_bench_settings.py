@@ -2,35 +2,22 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from dataclasses import replace
-from pathlib import Path
-from types import ModuleType, SimpleNamespace
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
-
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_tracking.py"
-
-
-def _bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_tracking", BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+from _benchmarks import load_benchmark
 
 
 def test_trajopt_settings_are_parsed_as_config_fields() -> None:
-    bench = _bench()
+    bench = load_benchmark("bench_tracking")
     settings = bench._trajopt_settings("dt_dynamics=0.05, optimize_durations=true")
     assert settings == (("dt_dynamics", 0.05), ("optimize_durations", True))
 
 
 def test_an_unknown_field_names_the_option_and_the_field() -> None:
-    bench = _bench()
+    bench = load_benchmark("bench_tracking")
     with pytest.raises(SystemExit, match="--trajopt: TrajoptConfig has no field 'dt_dynamic'"):
         bench._trajopt_settings("dt_dynamic=0.05")
     with pytest.raises(SystemExit, match="--tracking: TrackingConfig has no field"):
@@ -40,7 +27,7 @@ def test_an_unknown_field_names_the_option_and_the_field() -> None:
 def test_a_dotted_name_changes_one_field_of_melon_configs_nested_config() -> None:
     from roughwalk.trajopt import melon_config
 
-    bench = _bench()
+    bench = load_benchmark("bench_tracking")
     ((name, costs),) = bench._trajopt_settings("costs.force_between_nodes_penalty=10")
     assert name == "costs"
     assert costs == replace(melon_config().costs, force_between_nodes_penalty=10.0)
@@ -53,7 +40,7 @@ def test_a_dotted_name_changes_one_field_of_melon_configs_nested_config() -> Non
 
 
 def test_pyramid_violation_sees_a_stance_force_outside_the_cone_between_nodes() -> None:
-    bench = _bench()
+    bench = load_benchmark("bench_tracking")
     t = np.linspace(0.0, 2.0, 401)
     forces = np.zeros((t.size, 2, 3))
     forces[..., 2] = 100.0

@@ -5,6 +5,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 import pytest
+from _trajopt_problems import pallet_edge_climb
 from scipy.integrate import quad
 
 from roughwalk.robots import load_robot
@@ -48,21 +49,7 @@ def _quadrature(spline: NumericSpline, integrand) -> float:  # type: ignore[no-u
 @pytest.fixture(scope="module")
 def problem() -> tuple[Formulation, np.ndarray, np.ndarray]:
     """A short climb onto the pallet, every cost on, at a perturbed guess."""
-    config = melon_config(duration=2.0, steps=4)
-    terrain = TerrainModel(
-        load_terrain("single_pallet"), config.terrain, config.costs.step_edge_sigma
-    )
-    nlp = Formulation(config, TOWR_ANYMAL, make_gait("walk", 4, 2.0), terrain)
-    task = resolve(Task((0.55, 0.0, 0.0), (0.95, 0.05, 0.1)), TOWR_ANYMAL, terrain)
-    x = HeuristicInitializer().guess(nlp, task)
-    # Put the front left foot's second foothold on the pallet's edge, where the
-    # terrain spline curves the most.
-    parts = nlp.split(x)
-    motion = nlp.feet[0]
-    pos, vel = motion.unpack(parts[motion.name])
-    node = motion.phase_nodes(nlp.stance_phases(0)[1])[0]
-    pos[node : node + 2, 0] = 1.01
-    parts[motion.name] = motion.pack(pos, vel)
+    nlp, parts, task = pallet_edge_climb(melon_config(duration=2.0, steps=4))
     x = nlp.join(parts)
     x = x + np.random.default_rng(3).normal(scale=0.01, size=x.size)
     return nlp, x, task.vector()

@@ -7,6 +7,7 @@ from dataclasses import replace
 import casadi as ca
 import numpy as np
 import pytest
+from _trajopt_problems import pallet_edge_climb
 
 from roughwalk.robots import load_robot
 from roughwalk.terrain import load_terrain
@@ -82,25 +83,15 @@ def test_value_is_the_squared_excess_of_a_control_point() -> None:
 def test_gradient_and_hessian_against_finite_differences() -> None:
     # On the pallet's edge the terrain basis depends on the footholds: the
     # formulation's hand-assembled chain rule through the terrain is in play.
-    config = _config(WEIGHT, duration=2.0, steps=4)
-    terrain = TerrainModel(
-        load_terrain("single_pallet"), config.terrain, config.costs.step_edge_sigma
-    )
-    nlp = Formulation(config, TOWR_ANYMAL, make_gait("walk", 4, 2.0), terrain)
-    task = resolve(Task((0.55, 0.0, 0.0), (0.95, 0.05, 0.1)), TOWR_ANYMAL, terrain)
-    x, p = HeuristicInitializer().guess(nlp, task), task.vector()
-    parts = nlp.split(x)
-    motion = nlp.feet[0]
-    pos, vel = motion.unpack(parts[motion.name])
-    node = motion.phase_nodes(nlp.stance_phases(0)[1])[0]
-    pos[node : node + 2, 0] = 1.01
-    parts[motion.name] = motion.pack(pos, vel)
+    nlp, parts, task = pallet_edge_climb(_config(WEIGHT, duration=2.0, steps=4))
+    p = task.vector()
     # Large force rates: many control points outside the pyramid, the hinge active.
     for force in nlp.forces:
         q, v = force.unpack(parts[force.name])
         v[:] = np.random.default_rng(7).normal(scale=2000.0, size=v.shape)
         parts[force.name] = force.pack(q, v)
-    x = nlp.join(parts) + np.random.default_rng(3).normal(scale=0.01, size=x.size)
+    x = nlp.join(parts)
+    x = x + np.random.default_rng(3).normal(scale=0.01, size=x.size)
     assert _penalty(nlp, x, p) > 1.0
     names = [nlp.x[i].name() for i in range(x.size)]
     columns = [i for i, n in enumerate(names) if n.startswith(("foot_force_0", "foot_motion_0"))]

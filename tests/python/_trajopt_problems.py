@@ -1,0 +1,41 @@
+"""Small NLPs shared by the trajopt tests."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from roughwalk.terrain import load_terrain
+from roughwalk.trajopt import (
+    TOWR_ANYMAL,
+    Formulation,
+    HeuristicInitializer,
+    Task,
+    TerrainModel,
+    make_gait,
+)
+from roughwalk.trajopt.parameters import TrajoptConfig
+from roughwalk.trajopt.task import resolve
+
+
+def pallet_edge_climb(
+    config: TrajoptConfig,
+) -> tuple[Formulation, dict[str, np.ndarray], Task]:
+    """A 4-step, 2 s climb onto the single pallet, guessed by the heuristic.
+
+    The front left foot's second foothold is put on the pallet's edge, where
+    the terrain spline curves the most (the terrain's derivatives are in play
+    there). Returns the formulation, the guess split into its variable sets,
+    and the resolved task.
+    """
+    terrain = TerrainModel(
+        load_terrain("single_pallet"), config.terrain, config.costs.step_edge_sigma
+    )
+    nlp = Formulation(config, TOWR_ANYMAL, make_gait("walk", 4, 2.0), terrain)
+    task = resolve(Task((0.55, 0.0, 0.0), (0.95, 0.05, 0.1)), TOWR_ANYMAL, terrain)
+    parts = nlp.split(HeuristicInitializer().guess(nlp, task))
+    motion = nlp.feet[0]
+    pos, vel = motion.unpack(parts[motion.name])
+    node = motion.phase_nodes(nlp.stance_phases(0)[1])[0]
+    pos[node : node + 2, 0] = 1.01
+    parts[motion.name] = motion.pack(pos, vel)
+    return nlp, parts, task
