@@ -114,30 +114,25 @@ def triangle_margin(p: np.ndarray, tri: np.ndarray) -> float:
     return out
 
 
-@pytest.fixture(scope="module")
-def robot() -> rw.Robot:
-    return rw.load_robot("littledog")
-
-
 @pytest.fixture(scope="module", params=TERRAINS)
-def planned(request: pytest.FixtureRequest, robot: rw.Robot) -> tuple[FootstepPlanner, Any]:
-    planner = FootstepPlanner(robot, rw.load_terrain(request.param))
+def planned(request: pytest.FixtureRequest, littledog: rw.Robot) -> tuple[FootstepPlanner, Any]:
+    planner = FootstepPlanner(littledog, rw.load_terrain(request.param))
     plan = planner.plan(START, GOAL, time_limit=None, expansions=400)
     assert plan.status == "solved", plan.reason
     return planner, plan
 
 
 def test_every_certificate_holds_its_stance_in_mujoco(
-    robot: rw.Robot, planned: tuple[FootstepPlanner, Any]
+    littledog: rw.Robot, planned: tuple[FootstepPlanner, Any]
 ) -> None:
     planner, plan = planned
     config, terrain = planner.config, planner.terrain
-    model = robot.mj_model()
+    model = littledog.mj_model()
     data = mujoco.MjData(model)
     foot_geoms = {LEGS.index(leg): model.geom(f"{leg}_foot").id for leg in LEGS}
     radius = {i: float(model.geom_size[g][0]) for i, g in foot_geoms.items()}
-    joints = [model.joint(name).id for name in robot.joint_names]
-    base = model.body(robot.base_body).id
+    joints = [model.joint(name).id for name in littledog.joint_names]
+    base = model.body(littledog.base_body).id
     stances = plan.stances()
     order = config.walking_order
     moved = ["-"] + [f.leg for f in plan.footsteps[4:]]
@@ -149,7 +144,7 @@ def test_every_certificate_holds_its_stance_in_mujoco(
     half = 0.5 * float(np.max(centre.max(axis=0) - centre.min(axis=0))) + 0.2
     tree = cKDTree(surface_samples(terrain, middle, half))
     for k, (cert, stance) in enumerate(zip(certificates, stances, strict=True)):
-        data.qpos[:] = robot.qpos(cert.q, cert.base_pos, cert.base_quat)
+        data.qpos[:] = littledog.qpos(cert.q, cert.base_pos, cert.base_quat)
         mujoco.mj_kinematics(model, data)
         mujoco.mj_comPos(model, data)
         # Foot centres on their footholds: the contact point plus the radius along the normal.
@@ -178,11 +173,11 @@ def test_every_certificate_holds_its_stance_in_mujoco(
 
 
 def test_every_step_is_one_of_the_actions(
-    robot: rw.Robot, planned: tuple[FootstepPlanner, Any]
+    littledog: rw.Robot, planned: tuple[FootstepPlanner, Any]
 ) -> None:
     planner, plan = planned
     config = planner.config
-    nominal = robot.nominal_stance.feet[:, :2]
+    nominal = littledog.nominal_stance.feet[:, :2]
     nominal = nominal - nominal.mean(axis=0)
     actions = np.asarray(config.actions)
     h = planner.lattice[2]

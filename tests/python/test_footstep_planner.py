@@ -49,13 +49,8 @@ class BumpyCost:
 
 
 @pytest.fixture(scope="module")
-def robot() -> rw.Robot:
-    return rw.load_robot("littledog")
-
-
-@pytest.fixture(scope="module")
-def rocks(robot: rw.Robot) -> FootstepPlanner:
-    return FootstepPlanner(robot, rw.load_terrain(ROCKS))
+def rocks(littledog: rw.Robot) -> FootstepPlanner:
+    return FootstepPlanner(littledog, rw.load_terrain(ROCKS))
 
 
 @pytest.fixture(scope="module")
@@ -115,10 +110,10 @@ def test_plan_reaches_the_goal_with_the_issue_json_fields(
 
 
 def test_same_inputs_and_expansion_budget_give_the_same_plan(
-    robot: rw.Robot, rocks: FootstepPlanner, rocks_plan: Any
+    littledog: rw.Robot, rocks: FootstepPlanner, rocks_plan: Any
 ) -> None:
     again = rocks.plan(START, GOAL, time_limit=None, expansions=300)
-    fresh = FootstepPlanner(robot, rocks.terrain, rocks.config, sdf=rocks.sdf).plan(
+    fresh = FootstepPlanner(littledog, rocks.terrain, rocks.config, sdf=rocks.sdf).plan(
         START, GOAL, time_limit=None, expansions=300
     )
     for other in (again, fresh):
@@ -133,10 +128,10 @@ def test_same_inputs_and_expansion_budget_give_the_same_plan(
     assert again.certificate_cache_hits > fresh.certificate_cache_hits
 
 
-def test_epsilon_one_plan_cost_equals_the_exhaustive_optimum(robot: rw.Robot) -> None:
+def test_epsilon_one_plan_cost_equals_the_exhaustive_optimum(littledog: rw.Robot) -> None:
     # Coarse lattice, five actions, the admissible heuristic: small enough to search exhaustively.
     config = FootstepConfig.for_robot(
-        robot,
+        littledog,
         resolution=0.01,
         local_search_radius=0.0,
         actions=SMALL_ACTIONS,
@@ -144,7 +139,7 @@ def test_epsilon_one_plan_cost_equals_the_exhaustive_optimum(robot: rw.Robot) ->
         epsilon0=1.0,
     )
     terrain = rw.load_terrain(SMALL_ROCKS)
-    planner = FootstepPlanner(robot, terrain, config, cost=BumpyCost())
+    planner = FootstepPlanner(littledog, terrain, config, cost=BumpyCost())
     start, goal = (0.25, 0.0, 0.0), (0.34, 0.0)
     ara = planner.plan(start, goal, time_limit=None)
     exact = planner.plan(start, goal, time_limit=None, search="exhaustive")
@@ -154,9 +149,9 @@ def test_epsilon_one_plan_cost_equals_the_exhaustive_optimum(robot: rw.Robot) ->
     assert exact.steps >= 4
 
 
-def test_admissible_bounds_hold_against_the_exhaustive_optimum(robot: rw.Robot) -> None:
+def test_admissible_bounds_hold_against_the_exhaustive_optimum(littledog: rw.Robot) -> None:
     config = FootstepConfig.for_robot(
-        robot,
+        littledog,
         resolution=0.01,
         local_search_radius=0.0,
         actions=SMALL_ACTIONS,
@@ -165,7 +160,7 @@ def test_admissible_bounds_hold_against_the_exhaustive_optimum(robot: rw.Robot) 
         epsilon_decrement=0.5,
     )
     terrain = rw.load_terrain(SMALL_ROCKS)
-    planner = FootstepPlanner(robot, terrain, config, cost=BumpyCost())
+    planner = FootstepPlanner(littledog, terrain, config, cost=BumpyCost())
     start, goal = (0.25, 0.0, 0.0), (0.36, 0.01)
     optimum = planner.plan(start, goal, time_limit=None, search="exhaustive").cost
     plan = planner.plan(start, goal, time_limit=None)
@@ -189,9 +184,9 @@ def _stepping_stones() -> rw.Terrain:
     return rw.Terrain(heights, x[0], y[0], h, h, name="stepping stones in a chasm")
 
 
-def test_island_in_a_chasm_is_infeasible_once_open_is_exhausted(robot: rw.Robot) -> None:
-    config = FootstepConfig.for_robot(robot, resolution=0.02, local_search_radius=0.0)
-    planner = FootstepPlanner(robot, _stepping_stones(), config, cost=UnitCost())
+def test_island_in_a_chasm_is_infeasible_once_open_is_exhausted(littledog: rw.Robot) -> None:
+    config = FootstepConfig.for_robot(littledog, resolution=0.02, local_search_radius=0.0)
+    planner = FootstepPlanner(littledog, _stepping_stones(), config, cost=UnitCost())
     plan = planner.plan((0.2, 0.0, 0.0), (0.5, 0.0), time_limit=None)
     assert plan.status == "infeasible", plan.reason
     assert plan.footsteps == () and plan.cost is None and plan.states_expanded > 10
@@ -200,7 +195,7 @@ def test_island_in_a_chasm_is_infeasible_once_open_is_exhausted(robot: rw.Robot)
     assert sum(plan.certificate_failures.values()) > 0
 
 
-def test_bad_input_is_invalid_with_a_reason(robot: rw.Robot) -> None:
+def test_bad_input_is_invalid_with_a_reason(littledog: rw.Robot) -> None:
     # A 16 cm post at (0.45, 0.1): a trunk standing over it collides.
     h = 0.005
     x = np.arange(0.0, 0.8 + h / 2, h)
@@ -208,7 +203,7 @@ def test_bad_input_is_invalid_with_a_reason(robot: rw.Robot) -> None:
     gx, gy = np.meshgrid(x, y, indexing="ij")
     heights = np.where(np.hypot(gx - 0.45, gy - 0.1) < 0.03, 0.16, 0.0)
     terrain = rw.Terrain(heights, 0.0, -0.3, h, h, name="post")
-    planner = FootstepPlanner(robot, terrain, cost=UnitCost())
+    planner = FootstepPlanner(littledog, terrain, cost=UnitCost())
     cases = [
         ((0.2, 0.0, 0.0), (1.5, 0.0), "off the terrain"),
         ((0.2, 0.0, 0.0), (math.nan, 0.0), "finite"),
@@ -263,10 +258,10 @@ def test_callback_sees_each_improved_solution_and_can_stop_the_search(
         rocks.plan(START, GOAL, time_limit=None, expansions=300, callback=boom)
 
 
-def test_config_scales_with_the_robot_and_refuses_bad_values(robot: rw.Robot) -> None:
+def test_config_scales_with_the_robot_and_refuses_bad_values(littledog: rw.Robot) -> None:
     anymal = rw.load_robot("anymal_c")
-    small, large = FootstepConfig.for_robot(robot), FootstepConfig.for_robot(anymal)
-    ratio = hip_to_hip_length(anymal) / hip_to_hip_length(robot)
+    small, large = FootstepConfig.for_robot(littledog), FootstepConfig.for_robot(anymal)
+    ratio = hip_to_hip_length(anymal) / hip_to_hip_length(littledog)
     assert large.resolution / small.resolution == pytest.approx(ratio)
     assert large.goal_radius / small.goal_radius == pytest.approx(ratio)
     assert np.asarray(large.actions) / ratio == pytest.approx(
@@ -274,7 +269,8 @@ def test_config_scales_with_the_robot_and_refuses_bad_values(robot: rw.Robot) ->
     )
     assert 12 <= len(small.actions) <= 25
     assert (
-        FootstepConfig.for_robot(robot, certificate_clearance=0.006).certificate.clearance == 0.006
+        FootstepConfig.for_robot(littledog, certificate_clearance=0.006).certificate.clearance
+        == 0.006
     )
     for bad, match in (
         ({"heuristic": "manhattan"}, "heuristic"),
@@ -285,26 +281,28 @@ def test_config_scales_with_the_robot_and_refuses_bad_values(robot: rw.Robot) ->
         ({"certificate_max_iterations": 0}, "max_iterations"),
     ):
         with pytest.raises(ConfigError, match=match):
-            FootstepConfig.for_robot(robot, **bad)
+            FootstepConfig.for_robot(littledog, **bad)
 
 
-def test_plan_footsteps_is_the_one_call_form(robot: rw.Robot, rocks_plan: Any) -> None:
+def test_plan_footsteps_is_the_one_call_form(littledog: rw.Robot, rocks_plan: Any) -> None:
     terrain = rw.load_terrain(ROCKS)
-    plan = plan_footsteps(robot, terrain, START, GOAL, None, expansions=300)
+    plan = plan_footsteps(littledog, terrain, START, GOAL, None, expansions=300)
     assert plan.footsteps == rocks_plan.footsteps
-    euclid = plan_footsteps(robot, terrain, START, GOAL, None, expansions=50, heuristic="euclidean")
+    euclid = plan_footsteps(
+        littledog, terrain, START, GOAL, None, expansions=50, heuristic="euclidean"
+    )
     assert euclid.heuristic == "euclidean" and euclid.bound_guaranteed
 
 
 @pytest.mark.parametrize("name", [info.name for info in rw.robots.list_robots()])
 def test_every_registered_robot_plans_across_flat_ground(name: str) -> None:
-    robot = rw.load_robot(name)
-    config = FootstepConfig.for_robot(robot)
-    length = hip_to_hip_length(robot)
+    littledog = rw.load_robot(name)
+    config = FootstepConfig.for_robot(littledog)
+    length = hip_to_hip_length(littledog)
     terrain = rw.load_terrain(f"flat:length={6 * length:.3f},width={3 * length:.3f}")
     start = (1.5 * length, 0.0, 0.0)
     goal = (4.0 * length, 0.3 * length)
-    plan = FootstepPlanner(robot, terrain, config).plan(
+    plan = FootstepPlanner(littledog, terrain, config).plan(
         start, goal, time_limit=None, expansions=200
     )
     assert plan.status == "solved", plan.reason

@@ -22,15 +22,15 @@ from roughwalk.trajopt.variables import NumericSpline
 
 
 @pytest.fixture(scope="module")
-def robot():
+def anymal_c():
     return load_robot("anymal_c")
 
 
 @pytest.fixture(scope="module")
-def trot(robot) -> TrajoptResult:
+def trot(anymal_c) -> TrajoptResult:
     """A short optimised flat-ground trot: 6 steps, 0.3 m in 2 s."""
     result = optimize_motion(
-        robot,
+        anymal_c,
         load_terrain("flat"),
         Task((0.0, 0.0, 0.0), (0.3, 0.0, 0.0)),
         gait="trot",
@@ -41,14 +41,14 @@ def trot(robot) -> TrajoptResult:
     return result
 
 
-def test_keeps_anymal_c_standing_under_a_50_n_lateral_push(robot):
-    ns = robot.nominal_stance
+def test_keeps_anymal_c_standing_under_a_50_n_lateral_push(anymal_c):
+    ns = anymal_c.nominal_stance
     base = np.array([0.0, 0.0, ns.base_height])
-    feet = ns.feet + base - [0.0, 0.0, robot.foot_radius]
-    reference = Reference.standing(base, feet, robot.mass, duration=0.5)
+    feet = ns.feet + base - [0.0, 0.0, anymal_c.foot_radius]
+    reference = Reference.standing(base, feet, anymal_c.mass, duration=0.5)
     config = TrackingConfig(stand_after_s=1.0)
     push = TrunkPush((0.0, 50.0, 0.0), at_s=0.3, duration_s=0.2)
-    pushed = execute_reference(reference, robot, load_terrain("flat"), config, push=push)
+    pushed = execute_reference(reference, anymal_c, load_terrain("flat"), config, push=push)
     assert pushed.success, pushed.reason
     assert not pushed.fell
     log = pushed.log
@@ -59,17 +59,17 @@ def test_keeps_anymal_c_standing_under_a_50_n_lateral_push(robot):
     assert pushed.max_orientation_error_rad < 0.1
 
 
-def test_a_stalled_qp_tick_ends_the_run_as_a_reported_failure(robot):
+def test_a_stalled_qp_tick_ends_the_run_as_a_reported_failure(anymal_c):
     """A solver that hits its iteration limit stops the run at once, named as the reason."""
-    ns = robot.nominal_stance
+    ns = anymal_c.nominal_stance
     base = np.array([0.0, 0.0, ns.base_height])
-    feet = ns.feet + base - [0.0, 0.0, robot.foot_radius]
-    reference = Reference.standing(base, feet, robot.mass, duration=0.5)
-    fine = execute_reference(reference, robot, load_terrain("flat"), TrackingConfig())
+    feet = ns.feet + base - [0.0, 0.0, anymal_c.foot_radius]
+    reference = Reference.standing(base, feet, anymal_c.mass, duration=0.5)
+    fine = execute_reference(reference, anymal_c, load_terrain("flat"), TrackingConfig())
     assert fine.success, fine.reason
     # One proxqp outer iteration cannot reach 1e-8: every tick stalls.
     starved = TrackingConfig(qp_max_iter=1)
-    outcome = execute_reference(reference, robot, load_terrain("flat"), starved)
+    outcome = execute_reference(reference, anymal_c, load_terrain("flat"), starved)
     assert not outcome.success and not outcome.fell
     assert outcome.reason.startswith("the whole-body QP stalled at t = 0.00 s"), outcome.reason
     assert "iteration limit (1)" in outcome.reason

@@ -14,57 +14,59 @@ from roughwalk.tracking.swing import SwingPlanner, SwingTrajectory, minimum_jerk
 
 
 @pytest.fixture(scope="module")
-def robot():
+def anymal_c():
     return load_robot("anymal_c")
 
 
-def test_leg_reach_is_the_law_of_cosines_of_the_knee_bend(robot):
+def test_leg_reach_is_the_law_of_cosines_of_the_knee_bend(anymal_c):
     """distance() of forward-kinematics feet equals √(a² + b² + 2ab cos φ) for the knee bend φ."""
-    reach = LegReach(robot, 0.0)
+    reach = LegReach(anymal_c, 0.0)
     lower, upper = reach.joint_range(0.0, math.pi)
-    a, b = robot.leg_lengths[0]
+    a, b = anymal_c.leg_lengths[0]
     rng = np.random.default_rng(3)
-    names = robot.joint_names
-    knees = [names.index(leg[2]) for leg in robot.leg_joint_names]
+    names = anymal_c.joint_names
+    knees = [names.index(leg[2]) for leg in anymal_c.leg_joint_names]
     for _ in range(50):
-        q = robot.nominal_q + rng.uniform(-0.4, 0.4, 12)
-        feet = robot.foot_positions(q)
+        q = anymal_c.nominal_q + rng.uniform(-0.4, 0.4, 12)
+        feet = anymal_c.foot_positions(q)
         for leg, k in enumerate(knees):
             # The straight knee is the kept range's end nearer the nominal angle.
             ends = (lower[k], upper[k])
-            straight = min(ends, key=lambda e: abs(e - robot.nominal_q[k]))
+            straight = min(ends, key=lambda e: abs(e - anymal_c.nominal_q[k]))
             bend = abs(q[k] - straight)
             expected = math.sqrt(a * a + b * b + 2 * a * b * math.cos(bend))
             assert reach.distance(feet)[leg] == pytest.approx(expected, abs=1e-6)
 
 
-def test_knee_range_keeps_each_knee_on_its_nominal_branch(robot):
-    reach = LegReach(robot)
+def test_knee_range_keeps_each_knee_on_its_nominal_branch(anymal_c):
+    reach = LegReach(anymal_c)
     lower, upper = reach.joint_range(0.35, 2.4)
-    for leg, (haa, _, kfe) in enumerate(robot.leg_joint_names):
-        k = robot.joint_names.index(kfe)
-        assert lower[k] < robot.nominal_q[k] < upper[k]
+    for leg, (haa, _, kfe) in enumerate(anymal_c.leg_joint_names):
+        k = anymal_c.joint_names.index(kfe)
+        assert lower[k] < anymal_c.nominal_q[k] < upper[k]
         # Straightening the knee to the kept bound leaves the leg short of full reach.
-        q = robot.nominal_q.copy()
-        q[k] = upper[k] if robot.nominal_q[k] < 0.27 else lower[k]
-        assert reach.distance(robot.foot_positions(q))[leg] < float(np.sum(robot.leg_lengths[leg]))
-        i = robot.joint_names.index(haa)
-        assert robot.joint_lower[i] < lower[i] < upper[i] < robot.joint_upper[i]
+        q = anymal_c.nominal_q.copy()
+        q[k] = upper[k] if anymal_c.nominal_q[k] < 0.27 else lower[k]
+        assert reach.distance(anymal_c.foot_positions(q))[leg] < float(
+            np.sum(anymal_c.leg_lengths[leg])
+        )
+        i = anymal_c.joint_names.index(haa)
+        assert anymal_c.joint_lower[i] < lower[i] < upper[i] < anymal_c.joint_upper[i]
 
 
-def test_reach_aware_reference_lowers_a_too_high_base_smoothly_and_only_then(robot):
-    ns = robot.nominal_stance
-    feet = ns.feet + [0.0, 0.0, ns.base_height - robot.foot_radius]
-    reach = LegReach(robot)
+def test_reach_aware_reference_lowers_a_too_high_base_smoothly_and_only_then(anymal_c):
+    ns = anymal_c.nominal_stance
+    feet = ns.feet + [0.0, 0.0, ns.base_height - anymal_c.foot_radius]
+    reach = LegReach(anymal_c)
     # Nominal height: reachable, unchanged.
-    low = Reference.standing([0.0, 0.0, ns.base_height], feet, robot.mass, duration=1.0)
+    low = Reference.standing([0.0, 0.0, ns.base_height], feet, anymal_c.mass, duration=1.0)
     same, _, drop = reach_aware_reference(low, reach)
     assert same is low and not drop.any()
 
     # A base 12 cm higher: every foot out of reach; lowered just enough.
     def sampler(t: float):
         z = ns.base_height + 0.12 * min(t / 0.5, 1.0)
-        return Reference.standing([0.0, 0.0, z], feet, robot.mass)(0.0)
+        return Reference.standing([0.0, 0.0, z], feet, anymal_c.mass)(0.0)
 
     high = Reference(1.0, sampler)
     assert (reach.excess(high(1.0)) > 0.02).all()
@@ -82,7 +84,7 @@ def test_reach_aware_reference_lowers_a_too_high_base_smoothly_and_only_then(rob
         assert da == pytest.approx((dz[2] - 2 * dz[1] + dz[0]) / (h * h), abs=2e-2)
 
 
-def test_qp_respects_acceleration_bounds(robot):
+def test_qp_respects_acceleration_bounds(anymal_c):
     """With the joints' q̈ bounded the QP's q̈ stays inside, yet still obeys the dynamics."""
     from roughwalk.tracking.tasks import QPLayout, motion_task, regularisation
 
@@ -121,9 +123,9 @@ def test_minimum_jerk_derivatives_match_finite_differences():
     assert minimum_jerk(0.0) == (0.0, 0.0, 0.0) and minimum_jerk(1.0)[0] == 1.0
 
 
-def test_swing_clears_the_pallet_and_lands_off_its_edge(robot):
+def test_swing_clears_the_pallet_and_lands_off_its_edge(anymal_c):
     terrain = load_terrain("single_pallet")
-    planner = SwingPlanner(terrain, robot.foot_radius, clearance=0.08)
+    planner = SwingPlanner(terrain, anymal_c.foot_radius, clearance=0.08)
     # Find the pallet's front edge along y = 0.
     xs = np.linspace(terrain.extent[0], terrain.extent[1], 2000)
     h = terrain.height(np.stack([xs, np.zeros_like(xs)], axis=1))
@@ -132,7 +134,7 @@ def test_swing_clears_the_pallet_and_lands_off_its_edge(robot):
     # A foothold planned on the edge moves to flat ground within reach of the plan.
     on_edge = np.array([edge + 0.005, 0.0, 0.5 * top])
     foothold = planner.foothold(on_edge)
-    ring = foothold[:2] + (robot.foot_radius + 0.03) * np.array(
+    ring = foothold[:2] + (anymal_c.foot_radius + 0.03) * np.array(
         [[math.cos(a), math.sin(a)] for a in np.linspace(0, 2 * math.pi, 24)]
     )
     assert np.ptp(terrain.height(ring)) <= 0.01 + 1e-9

@@ -16,31 +16,26 @@ from roughwalk.trajectories.support_polygon import convex_polygon, polygon_margi
 
 
 @pytest.fixture(scope="module")
-def robot() -> rw.Robot:
-    return rw.load_robot("littledog")
-
-
-@pytest.fixture(scope="module")
-def barrier(robot: rw.Robot):
+def barrier(littledog: rw.Robot):
     terrain = rw.load_terrain(BARRIER)
     sdf = terrain.sdf(0.005)
-    gen = FootstepTrajectoryGenerator(robot, terrain, sdf=sdf)
-    return terrain, sdf, barrier_step_plan(robot, terrain, gen.wb)
+    gen = FootstepTrajectoryGenerator(littledog, terrain, sdf=sdf)
+    return terrain, sdf, barrier_step_plan(littledog, terrain, gen.wb)
 
 
 @pytest.fixture(scope="module")
-def barrier_result(robot: rw.Robot, barrier) -> FootstepTrajectories:
+def barrier_result(littledog: rw.Robot, barrier) -> FootstepTrajectories:
     terrain, sdf, plan = barrier
     return rw.footstep_trajectories(
-        plan, robot=robot, terrain=terrain, sdf=sdf, **low_swing_config()
+        plan, robot=littledog, terrain=terrain, sdf=sdf, **low_swing_config()
     )
 
 
 @pytest.fixture(scope="module")
-def crawl_result(robot: rw.Robot) -> FootstepTrajectories:
+def crawl_result(littledog: rw.Robot) -> FootstepTrajectories:
     terrain = rw.load_terrain("flat:length=1.2,width=0.5")
-    plan = straight_crawl_plan(robot, terrain, (0.3, 0.0), steps=6)
-    return rw.footstep_trajectories(plan, robot=robot, terrain=terrain)
+    plan = straight_crawl_plan(littledog, terrain, (0.3, 0.0), steps=6)
+    return rw.footstep_trajectories(plan, robot=littledog, terrain=terrain)
 
 
 def _point_triangle_distance(p, a, b, c) -> np.ndarray:
@@ -84,12 +79,12 @@ def test_point_triangle_distance_against_dense_sampling() -> None:
     assert np.all(exact <= brute + 1e-12) and np.all(brute - exact < 0.03)
 
 
-def _capsule_points(robot: rw.Robot, traj, spacing: float):
+def _capsule_points(littledog: rw.Robot, traj, spacing: float):
     """Dense points on every collision capsule that is not a supporting foot, all samples."""
-    cm = CollisionModel.from_robot(robot)
+    cm = CollisionModel.from_robot(littledog)
     pts, rad, prim = [], [], []
     for i in range(traj.time.shape[0]):
-        a, b = cm.world_segments(robot, traj.q[i], traj.base_pos[i], traj.base_quat[i])
+        a, b = cm.world_segments(littledog, traj.q[i], traj.base_pos[i], traj.base_quat[i])
         for k in range(len(cm)):
             if cm.is_foot[k] and traj.support[i, cm.leg[k]]:
                 continue
@@ -100,13 +95,13 @@ def _capsule_points(robot: rw.Robot, traj, spacing: float):
     return cm, np.concatenate(pts), np.concatenate(rad), np.concatenate(prim)
 
 
-def test_figure8_barrier_step_comes_out_collision_free(robot, barrier, barrier_result) -> None:
+def test_figure8_barrier_step_comes_out_collision_free(littledog, barrier, barrier_result) -> None:
     """Zucker 2011, Figure 8: the initial step hits the barrier with shin and foot; CHOMP clears."""
     terrain, sdf, plan = barrier
     initial = (
         rw.footstep_trajectories(
             plan,
-            robot=robot,
+            robot=littledog,
             terrain=terrain,
             sdf=sdf,
             **low_swing_config(**{"chomp.max_iterations": 0, "chomp.max_restarts": 0}),
@@ -124,7 +119,7 @@ def test_figure8_barrier_step_comes_out_collision_free(robot, barrier, barrier_r
 
     # Independent check: exact distances of dense capsule points to the barrier's triangles,
     # and heights over the flat ground (z = 0) everywhere else.
-    cm, pts, rad, prim = _capsule_points(robot, step, spacing=0.002)
+    cm, pts, rad, prim = _capsule_points(littledog, step, spacing=0.002)
     mesh = terrain.to_mesh()
     tri = np.asarray(mesh.vertices)[np.asarray(mesh.faces)]
     raised = tri[:, :, 2].max(axis=1) > 1e-9
@@ -147,9 +142,9 @@ def test_figure8_barrier_step_comes_out_collision_free(robot, barrier, barrier_r
 
 
 def test_no_produced_trajectory_violates_the_joint_velocity_limits(
-    robot, barrier_result, crawl_result
+    littledog, barrier_result, crawl_result
 ) -> None:
-    limit = robot.joint_velocity_limit
+    limit = littledog.joint_velocity_limit
     steps = barrier_result.steps + crawl_result.steps
     assert all(s.valid for s in steps)
     for s in steps:
@@ -162,7 +157,7 @@ def test_no_produced_trajectory_violates_the_joint_velocity_limits(
         )
 
 
-def test_crawl_output_is_consistent(robot, crawl_result: FootstepTrajectories) -> None:
+def test_crawl_output_is_consistent(littledog, crawl_result: FootstepTrajectories) -> None:
     res = crawl_result
     assert res.valid_fraction == 1.0
     data = res.sampled()
@@ -175,7 +170,7 @@ def test_crawl_output_is_consistent(robot, crawl_result: FootstepTrajectories) -
     for s in res.steps:
         feet = np.array(
             [
-                robot.foot_positions(q, p, r)
+                littledog.foot_positions(q, p, r)
                 for q, p, r in zip(s.q, s.base_pos, s.base_quat, strict=True)
             ]
         )
@@ -186,7 +181,7 @@ def test_crawl_output_is_consistent(robot, crawl_result: FootstepTrajectories) -
             poly = convex_polygon(s.feet[i][s.support[i]])
             assert polygon_margin(s.zmp[i][None], poly)[0][0] >= -1e-9
         total = s.contact_forces.sum(axis=1)
-        np.testing.assert_allclose(total[:, 2], robot.mass * 9.81, rtol=0.05)
+        np.testing.assert_allclose(total[:, 2], littledog.mass * 9.81, rtol=0.05)
         assert np.all(s.contact_forces[~s.support] == 0.0)
         moment = np.einsum(
             "tl,tli->ti", s.contact_forces[..., 2], s.feet[..., :2] - s.zmp[:, None, :]
@@ -206,7 +201,7 @@ def test_crawl_output_is_consistent(robot, crawl_result: FootstepTrajectories) -
             assert key in row
 
 
-def test_plan_errors_name_the_problem(robot) -> None:
+def test_plan_errors_name_the_problem(littledog) -> None:
     with pytest.raises(rw.PlanningError, match="footsteps"):
         rw.footstep_trajectories({"robot": "littledog", "terrain": "flat"})
     with pytest.raises(rw.PlanningError, match="at least one step"):
@@ -220,17 +215,19 @@ def test_plan_errors_name_the_problem(robot) -> None:
         rw.footstep_trajectories(bad)
 
 
-def test_swing_timing_under_the_landing_trunk_shortens_a_step_down(robot) -> None:
+def test_swing_timing_under_the_landing_trunk_shortens_a_step_down(littledog) -> None:
     # Stepping down from an 8 cm block, the swing pose leaves the landing foot
     # at the edge of its reach, where the knee's rate per metre soars; the
     # trunk the initial trajectory carries down to the landing pose does not.
     terrain = rw.load_terrain("barrier:height=0.08,thickness=0.06,center=1.0")
     sdf = terrain.sdf(0.005)
-    plan = step_down_plan(robot, terrain, FootstepTrajectoryGenerator(robot, terrain, sdf=sdf).wb)
+    plan = step_down_plan(
+        littledog, terrain, FootstepTrajectoryGenerator(littledog, terrain, sdf=sdf).wb
+    )
 
     def generator(trunk: str) -> FootstepTrajectoryGenerator:
         config = rw.trajectories.trajectory_config(**{"timing.swing_trunk": trunk})
-        return FootstepTrajectoryGenerator(robot, terrain, sdf=sdf, config=config)
+        return FootstepTrajectoryGenerator(littledog, terrain, sdf=sdf, config=config)
 
     still, landing, shorter = (
         generator(t).prepare(plan).timings[0] for t in ("still", "landing", "shorter")

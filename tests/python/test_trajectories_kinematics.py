@@ -22,51 +22,46 @@ from roughwalk.trajectories.whole_body import WholeBody
 
 
 @pytest.fixture(scope="module")
-def robot() -> rw.Robot:
-    return rw.load_robot("littledog")
+def wb(littledog: rw.Robot) -> WholeBody:
+    return WholeBody(littledog)
 
 
-@pytest.fixture(scope="module")
-def wb(robot: rw.Robot) -> WholeBody:
-    return WholeBody(robot)
-
-
-def _random_q(robot: rw.Robot, n: int, seed: int) -> np.ndarray:
+def _random_q(littledog: rw.Robot, n: int, seed: int) -> np.ndarray:
     rng = np.random.default_rng(seed)
-    q0 = robot.to_canonical(robot.nominal_q).reshape(4, 3)
+    q0 = littledog.to_canonical(littledog.nominal_q).reshape(4, 3)
     return q0[None] + rng.normal(0.0, 0.25, (n, 4, 3))
 
 
-def test_link_frames_match_the_reference_chain(robot: rw.Robot, wb: WholeBody) -> None:
-    q = _random_q(robot, 6, 0)
+def test_link_frames_match_the_reference_chain(littledog: rw.Robot, wb: WholeBody) -> None:
+    q = _random_q(littledog, 6, 0)
     positions, rotations, _, _ = wb.link_frames(q)
     for n in range(q.shape[0]):
-        for i, leg in enumerate(robot.leg_descriptions):
+        for i, leg in enumerate(littledog.leg_descriptions):
             p, r = reference_fk.leg_link_frames(leg, q[n, i])
             np.testing.assert_allclose(positions[n, i], p, atol=1e-12)
             np.testing.assert_allclose(rotations[n, i], r, atol=1e-12)
 
 
-def test_feet_com_and_ik_agree_with_the_robot(robot: rw.Robot, wb: WholeBody) -> None:
-    q = _random_q(robot, 4, 1)
+def test_feet_com_and_ik_agree_with_the_robot(littledog: rw.Robot, wb: WholeBody) -> None:
+    q = _random_q(littledog, 4, 1)
     feet = wb.foot_positions(q)
     com = wb.center_of_mass(q)
     for n in range(q.shape[0]):
-        q12 = robot.from_canonical(q[n].reshape(12))
-        np.testing.assert_allclose(feet[n], robot.foot_positions(q12), atol=1e-12)
-        np.testing.assert_allclose(com[n], robot.center_of_mass(q12), atol=1e-12)
-    nominal = robot.to_canonical(robot.nominal_q).reshape(1, 4, 3)
+        q12 = littledog.from_canonical(q[n].reshape(12))
+        np.testing.assert_allclose(feet[n], littledog.foot_positions(q12), atol=1e-12)
+        np.testing.assert_allclose(com[n], littledog.center_of_mass(q12), atol=1e-12)
+    nominal = littledog.to_canonical(littledog.nominal_q).reshape(1, 4, 3)
     q_ik, reached = wb.inverse_kinematics(wb.foot_positions(nominal))
     assert reached.all()
     np.testing.assert_allclose(wb.foot_positions(q_ik), wb.foot_positions(nominal), atol=1e-9)
 
 
-def test_body_points_lie_on_the_collision_capsules(robot: rw.Robot, wb: WholeBody) -> None:
-    q = _random_q(robot, 3, 2)
+def test_body_points_lie_on_the_collision_capsules(littledog: rw.Robot, wb: WholeBody) -> None:
+    q = _random_q(littledog, 3, 2)
     p_base, _ = wb.points_base(q)
     pts = wb.points
     for n in range(q.shape[0]):
-        a, b = wb.collision.world_segments(robot, robot.from_canonical(q[n].reshape(12)))
+        a, b = wb.collision.world_segments(littledog, littledog.from_canonical(q[n].reshape(12)))
         for u in range(len(pts)):
             k = pts.primitive[u]
             ab = b[k] - a[k]
@@ -82,12 +77,12 @@ def _pose_points(wb: WholeBody, feet_w, x, rpy, held_q, support):
     return x + p_base[0] @ rot.T
 
 
-def test_body_pass_jacobians_match_finite_differences(robot: rw.Robot, wb: WholeBody) -> None:
+def test_body_pass_jacobians_match_finite_differences(littledog: rw.Robot, wb: WholeBody) -> None:
     """Zucker 2011 §3.4: supporting legs follow by IK, the lifted leg rides rigidly."""
-    stance = robot.nominal_stance
+    stance = littledog.nominal_stance
     feet_w = stance.feet + [0.0, 0.0, stance.base_height]
     support = np.array([True, False, True, True])
-    held_q = robot.to_canonical(robot.nominal_q).reshape(4, 3) + [0.1, 0.3, -0.2]
+    held_q = littledog.to_canonical(littledog.nominal_q).reshape(4, 3) + [0.1, 0.3, -0.2]
     x0 = np.array([0.01, -0.005, stance.base_height + 0.01])
     rpy0 = np.array([0.05, -0.03, 0.1])
     rot = rpy_to_matrix(rpy0)
@@ -108,8 +103,8 @@ def test_body_pass_jacobians_match_finite_differences(robot: rw.Robot, wb: Whole
         np.testing.assert_allclose(jac[0, :, :, k], (plus - minus) / (2 * h), atol=1e-6)
 
 
-def test_swing_pass_jacobians_match_finite_differences(robot: rw.Robot, wb: WholeBody) -> None:
-    q = _random_q(robot, 1, 3)
+def test_swing_pass_jacobians_match_finite_differences(littledog: rw.Robot, wb: WholeBody) -> None:
+    q = _random_q(littledog, 1, 3)
     x = np.array([0.2, 0.1, 0.15])
     rot = rpy_to_matrix([0.1, -0.2, 0.3])
     leg = 2

@@ -26,15 +26,10 @@ from roughwalk.trajectories.generator import RETIME_MARGIN, FootstepTrajectoryGe
 
 
 @pytest.fixture(scope="module")
-def robot() -> rw.Robot:
-    return rw.load_robot("littledog")
-
-
-@pytest.fixture(scope="module")
-def crawl(robot: rw.Robot):
+def crawl(littledog: rw.Robot):
     terrain = rw.load_terrain("flat:length=1.2,width=0.5")
-    gen = FootstepTrajectoryGenerator(robot, terrain)
-    plan = straight_crawl_plan(robot, terrain, (0.3, 0.0), steps=4, stride=0.07)
+    gen = FootstepTrajectoryGenerator(littledog, terrain)
+    plan = straight_crawl_plan(littledog, terrain, (0.3, 0.0), steps=4, stride=0.07)
     return gen, gen.prepare(plan)
 
 
@@ -45,13 +40,13 @@ def _hurried(prepared, factor: float):
     )
 
 
-def _swing_leg_speed(traj, robot: rw.Robot, leg: int, limit: np.ndarray) -> np.ndarray:
+def _swing_leg_speed(traj, littledog: rw.Robot, leg: int, limit: np.ndarray) -> np.ndarray:
     """|q̇| / limit (n, 3) of the swing leg in a produced trajectory."""
-    qd = robot.to_canonical(traj.qd).reshape(-1, 4, 3)[:, leg]
+    qd = littledog.to_canonical(traj.qd).reshape(-1, 4, 3)[:, leg]
     return np.abs(qd) / limit
 
 
-def test_swing_speed_ratio_predicts_the_control_rate_check(crawl, robot: rw.Robot) -> None:
+def test_swing_speed_ratio_predicts_the_control_rate_check(crawl, littledog: rw.Robot) -> None:
     """The ratio is what resample_footstep's q̇ shows on the airborne swing leg."""
     gen, prepared = crawl
     cfg = gen.config
@@ -71,15 +66,15 @@ def test_swing_speed_ratio_predicts_the_control_rate_check(crawl, robot: rw.Robo
         leg = state.step.leg
         airborne = ~traj.support[:, leg]
         # The produced swing leg is exactly the spline the ratio differentiates.
-        q = robot.to_canonical(traj.q).reshape(-1, 4, 3)[airborne, leg]
+        q = littledog.to_canonical(traj.q).reshape(-1, 4, 3)[airborne, leg]
         np.testing.assert_allclose(q, swing_leg_angles(state, gen.wb, traj.time[airborne]))
-        speed = _swing_leg_speed(traj, robot, leg, gen.wb.velocity_limit[leg])[airborne]
+        speed = _swing_leg_speed(traj, littledog, leg, gen.wb.velocity_limit[leg])[airborne]
         # Away from lift-off and touchdown the differences are the same ones.
         assert np.max(speed[1:-1]) <= ratio + 1e-12
         assert ratio == pytest.approx(np.max(speed), rel=0.05)
 
 
-def test_a_hurried_swing_is_lengthened_before_chomp(crawl, robot: rw.Robot) -> None:
+def test_a_hurried_swing_is_lengthened_before_chomp(crawl, littledog: rw.Robot) -> None:
     """Timings 60 % too short: every step is stretched at once and keeps the limits.
 
     (The "even" swing time law's nominal 0.3 s swings use ~60 % of the
@@ -104,18 +99,18 @@ def test_a_hurried_swing_is_lengthened_before_chomp(crawl, robot: rw.Robot) -> N
     assert 1.0 < stretch <= ratio * RETIME_MARGIN * 1.1 + 0.05
 
 
-def test_steps_within_the_limits_are_not_stretched(robot: rw.Robot) -> None:
+def test_steps_within_the_limits_are_not_stretched(littledog: rw.Robot) -> None:
     """The barrier step at its nominal timing already keeps the limits: its duration stays."""
     terrain = rw.load_terrain(BARRIER)
-    gen = FootstepTrajectoryGenerator(robot, terrain)
-    prepared = gen.prepare(barrier_step_plan(robot, terrain, gen.wb))
+    gen = FootstepTrajectoryGenerator(littledog, terrain)
+    prepared = gen.prepare(barrier_step_plan(littledog, terrain, gen.wb))
     state = gen.initial_state(prepared, 0, prepared.start)
     assert swing_speed_ratio(state, gen.wb, gen.config.control_rate_hz) <= 1.0
     traj = next(iter(gen.iter_steps(prepared)))
     assert traj.report.duration_s == pytest.approx(prepared.timings[0].duration_s)
 
 
-def test_a_velocity_jump_is_not_restarted(crawl, robot: rw.Robot) -> None:
+def test_a_velocity_jump_is_not_restarted(crawl, littledog: rw.Robot) -> None:
     """A joint 'speed' no lengthening can bring under its limit is handed on, not restarted.
 
     Such jumps come from IK switching branch where a supporting foot is lost
@@ -124,7 +119,7 @@ def test_a_velocity_jump_is_not_restarted(crawl, robot: rw.Robot) -> None:
     """
     gen, prepared = crawl
     traj = next(iter(gen.iter_steps(prepared)))
-    limit = robot.from_canonical(gen.wb.velocity_limit.reshape(12))
+    limit = littledog.from_canonical(gen.wb.velocity_limit.reshape(12))
 
     def breaking(factor: float):
         qd = traj.qd.copy()
@@ -151,7 +146,7 @@ def test_a_velocity_jump_is_not_restarted(crawl, robot: rw.Robot) -> None:
 
 
 def test_the_swing_pass_stops_when_its_leg_is_clear_though_the_rest_is_not(
-    robot: rw.Robot,
+    littledog: rw.Robot,
 ) -> None:
     """Coordinate descent hands back to the trunk once the swing leg is done.
 
@@ -167,8 +162,8 @@ def test_the_swing_pass_stops_when_its_leg_is_clear_though_the_rest_is_not(
 
     terrain = rw.load_terrain(BARRIER)
     cfg = rw.trajectories.trajectory_config(**low_swing_config())
-    gen = FootstepTrajectoryGenerator(robot, terrain, config=cfg)
-    prepared = gen.prepare(barrier_step_plan(robot, terrain, gen.wb))
+    gen = FootstepTrajectoryGenerator(littledog, terrain, config=cfg)
+    prepared = gen.prepare(barrier_step_plan(littledog, terrain, gen.wb))
     state = gen.initial_state(prepared, 0, prepared.start)
     leg = state.step.leg
     other = (leg + 1) % 4
