@@ -405,11 +405,11 @@ class TrajoptConfig:
         process and stores nothing; "auto" loads them from the cache —
         compiled to C (:mod:`.compiled_nlp`) or in CasADi's serialised form
         (:mod:`.serialized_nlp`) — and on a miss builds them and stores the
-        serialised form (no compiler; 0.2–1.4 s of writing, 15–95 MB an
+        serialised form (no compiler; 0.13–1.2 s of writing, 15–95 MB an
         entry); "on" compiles a miss with gcc instead (seconds to minutes; a
         structure gcc cannot compile is serialised). A compiled hit skips
-        the whole build (TOWR's flat trot: 0.38 s of CPU), a serialised one
-        about a third to a half of it; the solve is the same. "off" is the
+        the whole build (TOWR's flat trot: 0.3 s of CPU), a serialised one
+        a fifth to two fifths of it; the solve is the same. "off" is the
         default because a miss costs more than a build.
 
     """

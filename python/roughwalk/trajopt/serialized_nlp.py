@@ -4,12 +4,16 @@ The second kind of entry of the NLP cache (:mod:`.compiled_nlp` is the
 first): the functions IPOPT and the results call, written with
 :class:`casadi.FileSerializer` and read back with
 :class:`casadi.FileDeserializer`. Reading is CasADi's virtual-machine code
-read from a file, not expressions built in Python and differentiated, so it
-costs about half to two thirds of the build (TOWR's flat 16-step trot: 0.17
-s of CPU against 0.38 s; Melon's single pallet with its exact Hessian: 1.0
-against 1.9 s) and needs no gcc. Writing costs 0.2–1.4 s once per structure
-and the entries are large (15 MB for the flat trot, 95 MB for the single
-pallet), which is why nothing is written unless the config asks for it.
+read from a file, not expressions built in Python and differentiated, and
+needs no gcc; but CasADi reads about a microsecond per instruction, close to
+what building costs, so it saves a fifth to two fifths of the build, not all
+of it. Build CPU [s] of TOWR's 16-step tasks (cold minus warm solve, session
+10): flat trot 0.28–0.33 built, 0.18 read; flat walk 0.31–0.32, 0.21; the
+walk with optimised durations 0.93–0.96, 0.68; block 1.5 m 0.37, 0.30;
+Melon's single pallet (exact Hessian, which gcc cannot compile) 1.89–1.91,
+1.12. Writing costs 0.13–1.2 s once per structure and the entries are large
+(15 MB for the flat trot, 95 MB for the single pallet), which is why nothing
+is written unless the config asks for it.
 
 Entries share the compiled cache's directory, key scheme (with the kind in
 the key) and safety: written under a temporary name and renamed into place,
