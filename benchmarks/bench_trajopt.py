@@ -24,7 +24,9 @@ default nothing is cached on disk: "cold" is a build from scratch. With
 ``--compiled on`` the first process compiles each NLP to C (gcc's CPU, in a
 child process, is the "gcc" column) and stores it in the cache
 (``$ROUGHWALK_CACHE``); a second process loads it ("build" says
-expression, compiled or cached).
+expression, compiled or cached). ``--compiled auto`` stores CasADi's
+serialised functions instead of compiling ("serialized", then
+"deserialized" in a later process).
 
 CPU time is not a fixed cost on a shared machine either: what runs on the
 other core (or hyper-thread) slows this one. In session 8 the same commit's

@@ -18,6 +18,7 @@ COMMAND_MODULES = [
     "roughwalk.cli.demo_cmd",
     "roughwalk.cli.plan_cmd",
     "roughwalk.cli.optimize_cmd",
+    "roughwalk.cli.cache_cmd",
     "roughwalk.cli.bench_cmd",
     "roughwalk.cli.cost_cmd",
     "roughwalk.cli.trajectory_cmd",

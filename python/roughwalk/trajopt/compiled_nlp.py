@@ -47,6 +47,7 @@ __all__ = [
     "structure_digest",
     "load",
     "compile_and_store",
+    "failed_before",
 ]
 
 COMPILER_FLAGS = ("-O1",)
@@ -98,12 +99,17 @@ def _source_digest() -> str:
     return digest.hexdigest()
 
 
-def structure_digest(body: Any, terrain_key: tuple[Any, ...], schedule: Any, config: Any) -> str:
-    """The cache key of one NLP structure (hex).
+def structure_digest(
+    body: Any, terrain_key: tuple[Any, ...], schedule: Any, config: Any, kind: str = "compiled"
+) -> str:
+    """The cache key of one NLP structure (hex) for entries of ``kind``.
 
     The config decides the cost set and with it the Hessian (exact or L-BFGS).
+    ``kind`` is "compiled" (here) or "serialized" (:mod:`.serialized_nlp`):
+    the two kinds of one structure are separate entries.
     """
     description = {
+        "kind": kind,
         "body": repr(body),
         "terrain": repr(terrain_key),
         "schedule": repr(
@@ -116,7 +122,7 @@ def structure_digest(body: Any, terrain_key: tuple[Any, ...], schedule: Any, con
             default=repr,
         ),
         "casadi": ca.CasadiMeta.version(),
-        "flags": (COMPILER_FLAGS, sorted(_CODEGEN_OPTIONS.items())),
+        "flags": (COMPILER_FLAGS, sorted(_CODEGEN_OPTIONS.items())) if kind == "compiled" else None,
         "source": _source_digest(),
     }
     text = json.dumps(description, sort_keys=True, default=repr)
@@ -173,7 +179,11 @@ def load(key: str, root: Path | None = None) -> CompiledNlp | None:
     try:
         meta = json.loads((entry / _META).read_text())
         library = entry / _LIBRARY
-        if meta.get("key") != key or _file_digest(library) != meta["library_digest"]:
+        if (
+            meta.get("key") != key
+            or meta.get("kind", "compiled") != "compiled"
+            or _file_digest(library) != meta["library_digest"]
+        ):
             raise ValueError("digest mismatch")
         functions = {
             name: ca.external(name, str(library))
@@ -191,6 +201,11 @@ def load(key: str, root: Path | None = None) -> CompiledNlp | None:
     except (OSError, ValueError, KeyError, TypeError, RuntimeError):
         _discard(entry)
         return None
+
+
+def failed_before(key: str, root: Path | None = None) -> bool:
+    """Whether compiling ``key`` failed in an earlier process (it is not tried again)."""
+    return ((root or cache_dir()) / f"{key}{_FAILED}").is_file()
 
 
 class CompileError(InvalidArgumentError):
@@ -255,6 +270,7 @@ def compile_and_store(
         (tmp / "nlp.c").unlink()
         meta = {
             "key": key,
+            "kind": "compiled",
             "functions": sorted(functions),
             "library_digest": _file_digest(tmp / _LIBRARY),
             "lbg": _bound(layout["lbg"]),

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from roughwalk.config import override, to_dict
 from roughwalk.errors import InvalidArgumentError
 from roughwalk.terrain import Terrain, load_terrain
-from roughwalk.trajopt import compiled_nlp
+from roughwalk.trajopt import compiled_nlp, serialized_nlp
 from roughwalk.trajopt.formulation import Formulation
 from roughwalk.trajopt.gaits import ContactSchedule, make_gait
 from roughwalk.trajopt.initializers import Initializer, make_initializer
@@ -90,36 +90,65 @@ class TrajoptProblem:
         self.build = "expression"
         """How the NLP's functions were made: "expression" (CasADi graphs built
         here), "compiled" (built, compiled to C and stored: the build time
-        includes gcc's) or "cached" (loaded from a compiled library)."""
+        includes gcc's), "cached" (loaded from a compiled library),
+        "serialized" (built and stored in CasADi's serialised form: the build
+        time includes the writing) or "deserialized" (read from that form)."""
         self.formulation = self._formulation()
         self.solver = TrajoptSolver(self.formulation, config.solver)
         self.build_time_s = time.perf_counter() - start
         self._build_pending = True
 
     def _formulation(self) -> Formulation:
-        """The NLP: from the compiled cache when the config allows (``compiled``)."""
+        """The NLP: from the on-disk cache when the config allows (``compiled``).
+
+        A compiled entry is preferred (nothing to read but the layout), then
+        a serialised one; "on" compiles a missing one, "auto" serialises it
+        (and so does "on" for a structure gcc could not compile).
+        """
         cfg, body, schedule, terrain = self.config, self.body, self.schedule, self.terrain
         if cfg.compiled == "off":
             return Formulation(cfg, body, schedule, terrain)
-        key = compiled_nlp.structure_digest(body, _terrain_key(terrain.terrain), schedule, cfg)
+        terrain_key = _terrain_key(terrain.terrain)
+        key = compiled_nlp.structure_digest(body, terrain_key, schedule, cfg)
         loaded = compiled_nlp.load(key)
-        if loaded is None and cfg.compiled == "on":
-            built = Formulation(cfg, body, schedule, terrain)
-            exact = hessian_choice(cfg.solver, bool(built.cost_names)) == "exact"
-            try:
-                compiled_nlp.compile_and_store(key, built.functions(exact), built.layout())
-            except compiled_nlp.CompileError as e:
-                warnings.warn(f"{e}; solving with CasADi's expressions", stacklevel=3)
-                return built
-            loaded = compiled_nlp.load(key)
-            if loaded is None:
-                return built
-            self.build = "compiled"
-        elif loaded is None:
-            return Formulation(cfg, body, schedule, terrain)
-        else:
+        if loaded is not None:
             self.build = "cached"
-        return Formulation(cfg, body, schedule, terrain, compiled=loaded)
+            return Formulation(cfg, body, schedule, terrain, compiled=loaded)
+        built = None
+        if cfg.compiled == "on" and not compiled_nlp.failed_before(key):
+            built = Formulation(cfg, body, schedule, terrain)
+            try:
+                compiled_nlp.compile_and_store(
+                    key, built.functions(self._exact(built)), built.layout()
+                )
+            except compiled_nlp.CompileError as e:
+                warnings.warn(f"{e}; solving with CasADi's serialised functions", stacklevel=3)
+            else:
+                loaded = compiled_nlp.load(key)
+                if loaded is None:
+                    return built
+                self.build = "compiled"
+                return Formulation(cfg, body, schedule, terrain, compiled=loaded)
+        serial_key = compiled_nlp.structure_digest(
+            body, terrain_key, schedule, cfg, kind=serialized_nlp.KIND
+        )
+        if built is None:
+            loaded = serialized_nlp.load(serial_key)
+            if loaded is not None:
+                self.build = "deserialized"
+                return Formulation(cfg, body, schedule, terrain, compiled=loaded)
+            built = Formulation(cfg, body, schedule, terrain)
+        try:
+            serialized_nlp.store(serial_key, built.functions(self._exact(built)), built.layout())
+        except (OSError, RuntimeError) as e:
+            warnings.warn(f"could not store the serialised NLP: {e}", stacklevel=3)
+            return built
+        self.build = "serialized"
+        return built
+
+    def _exact(self, built: Formulation) -> bool:
+        """Whether IPOPT will ask for the exact Hessian (then it is cached too)."""
+        return hessian_choice(self.config.solver, bool(built.cost_names)) == "exact"
 
     @property
     def n_variables(self) -> int:

@@ -99,7 +99,9 @@ class TrajoptResult:
     build:
         How the NLP's functions were made: "expression" (CasADi graphs),
         "compiled" (graphs compiled to C and cached; the build time includes
-        the compiler's) or "cached" (loaded from the cache).
+        the compiler's), "cached" (loaded compiled from the cache),
+        "serialized" (graphs stored in CasADi's serialised form; the build
+        time includes the writing) or "deserialized" (read from that form).
     objective:
         Objective value (0 for TOWR's feasibility problem).
     max_violation:
