@@ -228,6 +228,39 @@ class TimingConfig:
     settle_s:
         After the last step, four feet down while the centre of mass comes to
         rest over the final pose [s].
+
+    Session 10: where a run's clock goes, and the shift defaults
+    (``min_shift_s`` 0.2 → 0.1, ``first_shift_s`` 0 → 0.2,
+    ``velocity_margin`` 1.6 → 1.3). With session 9's defaults the demo
+    course (:func:`roughwalk.demo.run_demo`'s terrain, start and goal,
+    ``executor.plan_expansions`` 40000, no computing time charged) took
+    11.68 s: swings 7.84 s (0.34 s each), shifts 3.84 s (0.17 s each; every
+    side-changing one at the 0.2 s floor), no waits for optimisation (none
+    either with the computing time charged, ``compute_time_scale`` 1),
+    no reflexes; 23 footsteps of 9.4 cm strides, the feet's centroid
+    2.4 cm on per footstep (LittleDog board AD, bench logs seed 0: 4.49 s,
+    63 % swings, 37 % shifts, 8.1 cm strides). Longer strides
+    (``executor.longest_step`` 0.4) lengthen both phases more than the
+    stride (11.4 cm: swings 0.40 s, shifts 0.28 s, since the supporting
+    legs then sit near the edge of their reach, where their joints turn
+    fastest per metre; 4.62 cm/s). With the new shift defaults the demo
+    walks 5.14 → 5.64 cm/s (shifts 0.17 → 0.12 s), and the repeatable
+    bench (``roughwalk bench littledog --classes
+    barrier,steps,round_rocks,sloped_rocks,gap,logs,large_rocks
+    --expansions 40000 --seeds 2``) gives barrier 2/2 at 4.18 → 4.73
+    cm/s, steps 2/2 at 4.48 → 4.95, round rocks 2/2 at 4.06 → 4.34,
+    sloped rocks 1/2 at 5.36 → 5.90, gap 2/2 at 4.49 → 4.89, logs 2/2
+    at 4.77 → 4.80 (seed 0 5.15 → 5.60; seed 1 4.39 → 4.01, one reflex),
+    large rocks 1/2 at 3.23 → 2/2 at 3.21 (the seed both reach 3.23 →
+    3.41): every run the old defaults win still wins.
+    The fast timing's swing part on top (``swing.time_law`` "joint",
+    ``min_swing_s`` 0.2; demo 6.00 cm/s, barrier 5.29, steps 5.51, round
+    rocks 4.17) is not the default: with both, the robot falls under the
+    1 N·s left push at 2.0 s that each part alone survives. The 1 N·s side
+    push from 1.6 to 3.2 s (``roughwalk bench push_recovery --from 1.6
+    --to 3.2``, 0.2 s apart) to the right survives 7 → 8 of 9 (the old
+    defaults fall at 2.2 and 2.4 s, these at 2.2 s), to the left 8 → 7 of
+    9 (the old at 3.2 s, these at 2.2 and 3.0 s).
     """
 
     velocity_margin: float = 1.3
