@@ -109,8 +109,15 @@ def test_a_push_beyond_the_threshold_triggers_a_reflex_and_a_replan(littledog) -
     assert blind.outcome.reflexes == 0 and blind.outcome.replans == 0
 
 
-OLD_TIMING = {"timing.swing_trunk": "shorter", "timing.shift_travel_m": 0.0}
-"""The timing defaults until session 9, which the old gaits' push times name."""
+OLD_TIMING = {
+    "timing.swing_trunk": "shorter",
+    "timing.shift_travel_m": 0.0,
+    "timing.min_shift_s": 0.2,
+    "timing.first_shift_s": 0.0,
+    "timing.velocity_margin": 1.6,
+}
+"""The timing defaults until session 9 (the shift's until session 10), which the old
+gaits' push times name."""
 
 GAITS = {
     "knots": {"swing.time_law": "knots", "swing.lift_fraction": 0.1, **OLD_TIMING},
@@ -120,7 +127,7 @@ GAITS = {
 
 
 @pytest.mark.parametrize(
-    ("gait", "at_s"), [("knots", 2.0), ("knots", 2.6), ("even", 2.2), ("default", 3.2)]
+    ("gait", "at_s"), [("knots", 2.0), ("knots", 2.6), ("even", 2.2), ("default", 3.05)]
 )
 def test_one_reflex_rescues_a_push_to_the_right_mid_stride(
     littledog, gait: str, at_s: float
@@ -134,12 +141,18 @@ def test_one_reflex_rescues_a_push_to_the_right_mid_stride(
     # when the timed hold ended, and the re-plan's first step, lifting RF,
     # tipped it over. The "even" timing's shorter swings put 2.0 s where
     # the push fires no reflex; at 2.2 s (the shift before LH, four feet
-    # down) it does. The default gait (session 9: the trunk moves on during
-    # the swings, shifts that carry the ZMP little shrink to 0.06 s) is
-    # pushed 0.14 s into RF's 0.36 s swing, towards the lifted foot (one
-    # reflex rescues it from 3.05 to 3.25 s). Pushed as LF or RH lifts
-    # (2.2 s, 2.7 s) it rolls over to the right, as the "even" gait does
-    # when pushed as its LF lifts (2.78 s).
+    # down) it does. Session 9's default gait (the trunk moves on during
+    # the swings, shifts that carry the ZMP little shrink to 0.06 s) was
+    # pushed at 3.2 s, 0.14 s into RF's 0.36 s swing, towards the lifted
+    # foot (one reflex rescued it from 3.05 to 3.25 s). Pushed as LF or RH
+    # lifts (2.2 s, 2.7 s) it rolled over to the right, as the "even" gait
+    # does when pushed as its LF lifts (2.78 s). Session 10's shorter
+    # side-changing shifts (0.2 -> 0.1 s) bring RF's swing 0.1 s earlier
+    # (2.90-3.26 s): at 3.2 s the push lands as RF touches down and fires
+    # no reflex; at 3.05 s, 0.15 s into the swing as before, one reflex
+    # rescues it (trunk roll 15°; pushed at 3.0 s it rolls 17°, past this
+    # test's 0.3 rad, and still reaches the goal; the sweep from 1.6 to
+    # 3.2 s in 0.2 s steps: only 2.2 s, LF's lift-off, falls).
     terrain = roughwalk.load_terrain("flat")
     push = Push(impulse_ns=1.0, at_s=at_s, direction_deg=-90.0)
     result = walk(

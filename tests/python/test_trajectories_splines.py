@@ -57,7 +57,7 @@ def test_a_shift_that_moves_the_zmp_less_takes_less_down_to_the_hold() -> None:
     limits = np.full((4, 3), 10.0)
     still = np.zeros((2, 4, 3))
     swing = np.zeros((41, 3))
-    cfg = TimingConfig(min_shift_s=0.2, shift_travel_m=0.02, min_hold_s=0.06)
+    cfg = TimingConfig(min_shift_s=0.2, shift_travel_m=0.02, min_hold_s=0.06, velocity_margin=1.6)
     assert cfg.shift_floor(0.03) == pytest.approx(0.2)
     assert cfg.shift_floor(0.01) == pytest.approx(0.1)
     assert cfg.shift_floor(0.0) == pytest.approx(0.06)

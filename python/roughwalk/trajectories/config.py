@@ -49,8 +49,13 @@ class TimingConfig:
         Factor (≥ 1) on the shift phase's minimum time, the largest joint
         travel over its velocity limit (§5.2). The CoM's smooth motion peaks
         near twice its mean speed, but most LittleDog shifts are short and
-        take ``min_shift_s``: 1.6 costs no restarts on the barrier course
-        (1.3 restarts every other step); larger values walk slower.
+        take ``min_shift_s``. 1.3 since session 10 (1.6 before; timed by
+        the ends' travel, 1.3 restarted every other barrier step): with the
+        shift timed by its legs' peak joint rate along the trunk's path the
+        few long shifts (0.3–0.5 s on the demo course) shrink by a fifth,
+        and a step whose joints would still outrun a limit is lengthened
+        by the generator's re-timing and restarts. Larger values walk
+        slower. See "Session 10" below.
     swing_velocity_margin:
         Factor (≥ 1) on the swing's minimum time, the duration at which the
         foot spline's peak joint speeds reach the limits. The trunk moves
@@ -73,7 +78,9 @@ class TimingConfig:
         → 5.21, round rocks 1/2 at 3.12 → 1/2 at 4.23, sloped rocks 1/2 at
         4.16 → 1/2 at 5.09 (the same seeds fail); the 1 N·s side push
         (``roughwalk bench push_recovery --direction 90`` / ``-90``) 16 and
-        16 of 17. It is not the default:
+        16 of 17. 0.1 is the default since session 10, with
+        ``first_shift_s`` 0.2 (see "Session 10" below); the rest of the
+        fast timing is not, and before that none of it was, because:
         with 0.1 here the ZMP leaves the support polygon in the first step
         of a flat straight crawl and in the Figure 8 barrier step (both
         invalid after CHOMP's restarts; ``first_shift_s`` 0.2 mends both
@@ -108,7 +115,7 @@ class TimingConfig:
         next foot lifts.
     first_shift_s:
         Shortest shift phase [s] of a plan's first step, which starts from
-        rest (at most ``min_shift_s``, the default 0: no floor of its own).
+        rest (0.2 since session 10; 0, no floor of its own, before).
         The cart-table moves its ZMP only by accelerating the CoM, and from
         rest the preview controller has no earlier motion to start the move
         in: with the fast timing's 0.1 s the ZMP left the support polygon
@@ -119,7 +126,8 @@ class TimingConfig:
         5.16 (5.21), barrier 5.67 (5.71), but round rocks at 2.99 with 3
         reflexes (4.17, none), and the side push survives 16 of 17 to the
         left and only 13 to the right (16 without: falls at 2.0–2.4 s and
-        4.4 s), so it stays 0.
+        4.4 s), so it stayed 0 until session 10 made it 0.2 with
+        ``min_shift_s`` 0.1 (see "Session 10" below).
     min_swing_s:
         Shortest swing phase [s].
     swing_trunk:
@@ -220,14 +228,47 @@ class TimingConfig:
     settle_s:
         After the last step, four feet down while the centre of mass comes to
         rest over the final pose [s].
+
+    Session 10: where a run's clock goes, and the shift defaults
+    (``min_shift_s`` 0.2 → 0.1, ``first_shift_s`` 0 → 0.2,
+    ``velocity_margin`` 1.6 → 1.3). With session 9's defaults the demo
+    course (:func:`roughwalk.demo.run_demo`'s terrain, start and goal,
+    ``executor.plan_expansions`` 40000, no computing time charged) took
+    11.68 s: swings 7.84 s (0.34 s each), shifts 3.84 s (0.17 s each; every
+    side-changing one at the 0.2 s floor), no waits for optimisation (none
+    either with the computing time charged, ``compute_time_scale`` 1),
+    no reflexes; 23 footsteps of 9.4 cm strides, the feet's centroid
+    2.4 cm on per footstep (LittleDog board AD, bench logs seed 0: 4.49 s,
+    63 % swings, 37 % shifts, 8.1 cm strides). Longer strides
+    (``executor.longest_step`` 0.4) lengthen both phases more than the
+    stride (11.4 cm: swings 0.40 s, shifts 0.28 s, since the supporting
+    legs then sit near the edge of their reach, where their joints turn
+    fastest per metre; 4.62 cm/s). With the new shift defaults the demo
+    walks 5.14 → 5.64 cm/s (shifts 0.17 → 0.12 s), and the repeatable
+    bench (``roughwalk bench littledog --classes
+    barrier,steps,round_rocks,sloped_rocks,gap,logs,large_rocks
+    --expansions 40000 --seeds 2``) gives barrier 2/2 at 4.18 → 4.73
+    cm/s, steps 2/2 at 4.48 → 4.95, round rocks 2/2 at 4.06 → 4.34,
+    sloped rocks 1/2 at 5.36 → 5.90, gap 2/2 at 4.49 → 4.89, logs 2/2
+    at 4.77 → 4.80 (seed 0 5.15 → 5.60; seed 1 4.39 → 4.01, one reflex),
+    large rocks 1/2 at 3.23 → 2/2 at 3.21 (the seed both reach 3.23 →
+    3.41): every run the old defaults win still wins.
+    The fast timing's swing part on top (``swing.time_law`` "joint",
+    ``min_swing_s`` 0.2; demo 6.00 cm/s, barrier 5.29, steps 5.51, round
+    rocks 4.17) is not the default: with both, the robot falls under the
+    1 N·s left push at 2.0 s that each part alone survives. The 1 N·s side
+    push from 1.6 to 3.2 s (``roughwalk bench push_recovery --from 1.6
+    --to 3.2``, 0.2 s apart) to the right survives 7 → 8 of 9 (the old
+    defaults fall at 2.2 and 2.4 s, these at 2.2 s), to the left 8 → 7 of
+    9 (the old at 3.2 s, these at 2.2 and 3.0 s).
     """
 
-    velocity_margin: float = 1.6
+    velocity_margin: float = 1.3
     swing_velocity_margin: float = 1.1
-    min_shift_s: float = 0.2
+    min_shift_s: float = 0.1
     shift_travel_m: float = 0.02
     min_hold_s: float = 0.06
-    first_shift_s: float = 0.0
+    first_shift_s: float = 0.2
     min_swing_s: float = 0.3
     max_step_s: float = 4.0
     settle_s: float = 0.8
