@@ -204,6 +204,7 @@ GUESS_START_OPTIONS: tuple[str, ...] = (
     "warm_start_mult_bound_push=1e-5",
     "mumps_scaling=0",
     "mumps_permuting_scaling=0",
+    "fast_step_computation=yes",
 )
 """IPOPT's options for a start from predicted multipliers (see ``SolverOptions``)."""
 
@@ -302,6 +303,31 @@ class SolverOptions:
         PORD 23.5, METIS 33.4. With L-BFGS the ordering changes the
         iterations: TOWR's walk from its own solution took 18 with AMD and
         3 with the automatic choice, which L-BFGS keeps.
+        ``fast_step_computation=yes`` (no residual check of the KKT solve) is
+        on: the same iterations and costs on every task measured (50 held-out
+        single-pallet tasks: 626 iterations either way, median CPU 0.276 s
+        against 0.296; 8 double-pallet: 625, 2.74 against 2.93; 20 flat with
+        the option below as well: 200, 0.196 against 0.213; paired per task,
+        interleaved in one process).
+        ``adaptive_mu_globalization=never-monotone-mode`` (the adaptive
+        barrier update never falls back to the monotone one) is not: alone
+        it took the 50 single-pallet tasks in 609 iterations, with the
+        option above 200 of them in 2781 (median 12) against 2855 (13),
+        median CPU 0.275 s against 0.307, the same
+        196 converged to the same costs, but on the double pallet the solves
+        that fail either way (5 of 8, the weak model) took 86 ms an
+        iteration against 39, one stopped by the 40 s limit; from the
+        heuristic guess the pair saved iterations (626 against 686 on 12
+        tasks) with one ending 1 % dearer. Measured and not kept (30 tasks,
+        same order, median iterations / ms of CPU an iteration; base
+        11.5 / 24.8): the monotone update with ``mu_init`` 1e-3…1e-6 18 / 22.7 … 12.5 / 24.6
+        with one task unconverged below 1e-4; ``mu_oracle`` loqo 15 / 23.1,
+        probing 13 / 24.1; ``quality_function_max_section_steps`` 2 and 0
+        12 / 24.6 and 14 / 24.2; ``min_refinement_steps=0`` on top 11 / 23.5
+        (no gain). The barrier update's share of IPOPT's time is the KKT
+        factorisation done there first, not the oracle: other oracles
+        move it, they do not remove it. SPRAL (linked in CasADi's IPOPT,
+        ``linear_solver=spral``, one thread) took 172 ms an iteration.
 
     Neither set applies to a solve from a guess without multipliers (the
     heuristic's cold solves).
