@@ -117,6 +117,30 @@ def test_qp_hard_contacts_keep_stance_feet_still(world):
     assert np.abs(jc @ soft.qacc + bias).max() > 1e-3  # the hard rows did something
 
 
+def test_qp_with_unholdable_hard_contacts_falls_back_to_stance_tasks_within_limits(world):
+    """Feet that no torque within the limits can hold still: a solution, not a failed tick.
+
+    A failed tick re-applies the previous tick's torques; on the double pallet
+    that happened on up to 20 ticks of a run (issue 10).
+    """
+    rng = np.random.default_rng(13)
+    _, mass, h, jc, qp, tasks = _problem(world, rng, np.zeros(6))
+    # Holding the feet still would take 300 m/s² at every foot: far past 80 N·m.
+    bias = np.tile([300.0, -300.0, 300.0], 4)
+    sol = qp.solve(mass, h, jc, tasks, contact_bias=bias)
+    assert sol.success and sol.relaxed
+    assert np.all(np.abs(sol.tau) <= world.torque_limit + 1e-5)
+    f = sol.forces
+    assert np.all(f[:, 2] >= 2.0 - 1e-5)
+    assert np.all(np.abs(f[:, :2]) <= MU * f[:, 2:] + 1e-5)
+    s_tau = np.zeros(mass.shape[0])
+    s_tau[world.joint_dof] = sol.tau
+    residual = mass @ sol.qacc + h - s_tau - jc.T @ f.ravel()
+    assert np.abs(residual).max() < 1e-5 * (1.0 + np.abs(h).max())
+    held = qp.solve(mass, h, jc, tasks, contact_bias=np.zeros(jc.shape[0]))
+    assert held.success and not held.relaxed
+
+
 def test_friction_pyramid_contains_the_cone_inside_and_excludes_outside():
     rng = np.random.default_rng(3)
     normal = rng.normal(size=3)
@@ -191,6 +215,24 @@ def test_contact_state_machine_early_late_flicker_and_slip():
     assert est.slipping.tolist() == [False, True, False, False]
     sm.update(0.22, planned, zero, [50.0, 30.0, 20.0, 100.0], speed)
     assert sm.counts["slip"] == 1
+
+
+def test_a_planned_stance_foot_resting_on_the_ground_is_in_stance_however_light():
+    """A foot on the ground under 1 N is in stance, not late (issue 10's flicker)."""
+    sm = ContactStateMachine(ContactStateConfig(contact_force_n=5.0, release_force_n=1.0))
+    planned = np.ones(4, dtype=bool)
+    zero = np.zeros(4)
+    light = np.array([0.5, 0.0, 0.5, 100.0])
+    on_ground = np.array([True, True, False, True])
+    est = sm.update(0.0, planned, zero, light, zero, on_ground)
+    assert est.states[:3] == (LegContact.STANCE, LegContact.STANCE, LegContact.LATE_TOUCHDOWN)
+    # Without the contact flags the force alone decides: all three are late.
+    est = ContactStateMachine(sm.config).update(0.0, planned, zero, light, zero)
+    assert est.states[:3] == (LegContact.LATE_TOUCHDOWN,) * 3
+    # A swinging foot that brushes the ground early in its swing still swings.
+    swing = np.array([False, True, True, True])
+    est = sm.update(0.01, swing, [0.2, 0.0, 0.0, 0.0], light, zero, on_ground)
+    assert est.states[0] == LegContact.SWING
 
 
 def test_terrain_covering_pads_with_edge_heights_and_keeps_the_original():

@@ -156,6 +156,10 @@ class ContactStateConfig:
         It stops reaching down this far [m] below the planned foothold.
     slip_speed_m_s:
         A stance foot moving faster than this [m/s] slips.
+    ground_contact:
+        A foot planned in stance that touches the terrain at all (any
+        contact, whatever its force) is in stance, not late: a lightly
+        loaded foot on the ground otherwise flickers between the two.
     """
 
     contact_force_n: float = 5.0
@@ -164,9 +168,12 @@ class ContactStateConfig:
     search_speed_m_s: float = 0.3
     search_depth_m: float = 0.1
     slip_speed_m_s: float = 0.1
+    ground_contact: bool = True
 
     def __post_init__(self) -> None:
-        _positive(self, tuple(self.__dataclass_fields__), "contact")
+        _positive(
+            self, tuple(n for n in self.__dataclass_fields__ if n != "ground_contact"), "contact"
+        )
 
 
 @dataclass(frozen=True)
