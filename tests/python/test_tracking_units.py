@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import mujoco
 import numpy as np
 import pytest
@@ -139,6 +141,22 @@ def test_qp_with_unholdable_hard_contacts_falls_back_to_stance_tasks_within_limi
     assert np.abs(residual).max() < 1e-5 * (1.0 + np.abs(h).max())
     held = qp.solve(mass, h, jc, tasks, contact_bias=np.zeros(jc.shape[0]))
     assert held.success and not held.relaxed
+
+
+def test_qp_of_a_real_tick_that_proxqp_called_infeasible_is_solved():
+    """A single-pallet tick's QP (dynamics rows only: feasible by construction).
+
+    With proxqp's default infeasibility tolerance (1e-4) it was declared
+    primally infeasible after a few iterations and the tick failed (issue 10;
+    12 such ticks in that run).
+    """
+    path = Path(__file__).resolve().parents[1] / "data" / "tracking_qp_spuriously_infeasible.npz"
+    z = np.load(path)
+    qp = WholeBodyQP(z["actuated"], z["torque_limit"], MU)
+    x, stalled = qp._solve_qp(z["p"], z["q"], z["g"], z["g_h"], z["a_eq"], z["b_eq"], None, None)
+    assert x is not None and not stalled
+    np.testing.assert_allclose(z["a_eq"] @ x, z["b_eq"], atol=1e-5 * (1 + np.abs(z["b_eq"]).max()))
+    assert np.all(z["g"] @ x <= z["g_h"] + 1e-5)
 
 
 def test_friction_pyramid_contains_the_cone_inside_and_excludes_outside():

@@ -322,6 +322,13 @@ class WholeBodyQP:
         solver.settings.eps_rel = 0.0
         solver.settings.max_iter = self.max_iter
         solver.settings.max_iter_in = _PROXQP_MAX_ITER_IN
+        # proxqp's infeasibility test (default 1e-4) is absolute: with forces
+        # of kN and torques of 80 N·m in one vector it declared QPs infeasible
+        # after 3–10 iterations that are feasible by construction (q̈ free in
+        # the dynamics rows alone); issue 10 counted up to 20 such failed
+        # ticks a run, each re-applying the previous torques.
+        solver.settings.eps_primal_inf = _PROXQP_EPS_INFEASIBLE
+        solver.settings.eps_dual_inf = _PROXQP_EPS_INFEASIBLE
         solver.settings.verbose = False
         solver.init(sp.csc_matrix(p), q, sp.csc_matrix(a_eq), b_eq, sp.csc_matrix(c), lower, upper)
         solver.solve()
@@ -337,6 +344,7 @@ class WholeBodyQP:
 # (proxqp's own limits, 10⁴ × 1500, to minutes).
 _DEFAULT_MAX_ITER = {"proxqp": 1000, "osqp": 20000}
 _PROXQP_MAX_ITER_IN = 100
+_PROXQP_EPS_INFEASIBLE = 1e-12
 
 
 def _solver_options(solver: str, max_iter: int) -> dict[str, Any]:
