@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import mujoco
 import numpy as np
 import pytest
@@ -117,6 +119,46 @@ def test_qp_hard_contacts_keep_stance_feet_still(world):
     assert np.abs(jc @ soft.qacc + bias).max() > 1e-3  # the hard rows did something
 
 
+def test_qp_with_unholdable_hard_contacts_falls_back_to_stance_tasks_within_limits(world):
+    """Feet that no torque within the limits can hold still: a solution, not a failed tick.
+
+    A failed tick re-applies the previous tick's torques; on the double pallet
+    that happened on up to 20 ticks of a run (issue 10).
+    """
+    rng = np.random.default_rng(13)
+    _, mass, h, jc, qp, tasks = _problem(world, rng, np.zeros(6))
+    # Holding the feet still would take 300 m/s² at every foot: far past 80 N·m.
+    bias = np.tile([300.0, -300.0, 300.0], 4)
+    sol = qp.solve(mass, h, jc, tasks, contact_bias=bias)
+    assert sol.success and sol.relaxed
+    assert np.all(np.abs(sol.tau) <= world.torque_limit + 1e-5)
+    f = sol.forces
+    assert np.all(f[:, 2] >= 2.0 - 1e-5)
+    assert np.all(np.abs(f[:, :2]) <= MU * f[:, 2:] + 1e-5)
+    s_tau = np.zeros(mass.shape[0])
+    s_tau[world.joint_dof] = sol.tau
+    residual = mass @ sol.qacc + h - s_tau - jc.T @ f.ravel()
+    assert np.abs(residual).max() < 1e-5 * (1.0 + np.abs(h).max())
+    held = qp.solve(mass, h, jc, tasks, contact_bias=np.zeros(jc.shape[0]))
+    assert held.success and not held.relaxed
+
+
+def test_qp_of_a_real_tick_that_proxqp_called_infeasible_is_solved():
+    """A single-pallet tick's QP (dynamics rows only: feasible by construction).
+
+    With proxqp's default infeasibility tolerance (1e-4) it was declared
+    primally infeasible after a few iterations and the tick failed (issue 10;
+    12 such ticks in that run).
+    """
+    path = Path(__file__).resolve().parents[1] / "data" / "tracking_qp_spuriously_infeasible.npz"
+    z = np.load(path)
+    qp = WholeBodyQP(z["actuated"], z["torque_limit"], MU)
+    x, stalled = qp._solve_qp(z["p"], z["q"], z["g"], z["g_h"], z["a_eq"], z["b_eq"], None, None)
+    assert x is not None and not stalled
+    np.testing.assert_allclose(z["a_eq"] @ x, z["b_eq"], atol=1e-5 * (1 + np.abs(z["b_eq"]).max()))
+    assert np.all(z["g"] @ x <= z["g_h"] + 1e-5)
+
+
 def test_friction_pyramid_contains_the_cone_inside_and_excludes_outside():
     rng = np.random.default_rng(3)
     normal = rng.normal(size=3)
@@ -191,6 +233,24 @@ def test_contact_state_machine_early_late_flicker_and_slip():
     assert est.slipping.tolist() == [False, True, False, False]
     sm.update(0.22, planned, zero, [50.0, 30.0, 20.0, 100.0], speed)
     assert sm.counts["slip"] == 1
+
+
+def test_a_planned_stance_foot_resting_on_the_ground_is_in_stance_however_light():
+    """A foot on the ground under 1 N is in stance, not late (issue 10's flicker)."""
+    sm = ContactStateMachine(ContactStateConfig(contact_force_n=5.0, release_force_n=1.0))
+    planned = np.ones(4, dtype=bool)
+    zero = np.zeros(4)
+    light = np.array([0.5, 0.0, 0.5, 100.0])
+    on_ground = np.array([True, True, False, True])
+    est = sm.update(0.0, planned, zero, light, zero, on_ground)
+    assert est.states[:3] == (LegContact.STANCE, LegContact.STANCE, LegContact.LATE_TOUCHDOWN)
+    # Without the contact flags the force alone decides: all three are late.
+    est = ContactStateMachine(sm.config).update(0.0, planned, zero, light, zero)
+    assert est.states[:3] == (LegContact.LATE_TOUCHDOWN,) * 3
+    # A swinging foot that brushes the ground early in its swing still swings.
+    swing = np.array([False, True, True, True])
+    est = sm.update(0.01, swing, [0.2, 0.0, 0.0, 0.0], light, zero, on_ground)
+    assert est.states[0] == LegContact.SWING
 
 
 def test_terrain_covering_pads_with_edge_heights_and_keeps_the_original():

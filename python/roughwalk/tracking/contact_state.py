@@ -90,6 +90,7 @@ class ContactStateMachine:
         swing_progress: ArrayLike,
         normal_force: ArrayLike,
         foot_speed: ArrayLike,
+        on_ground: ArrayLike | None = None,
     ) -> ContactEstimate:
         """Advance every leg's state to time ``t`` [s].
 
@@ -105,6 +106,15 @@ class ContactStateMachine:
             (4,) measured normal force on each foot [N].
         foot_speed:
             (4,) measured foot speed [m/s].
+        on_ground:
+            (4,) the foot touches the terrain at all (a contact exists, whatever
+            its force); None: judge by the force alone. A foot planned in stance
+            that rests on the ground is in stance even when lightly loaded:
+            else it counts as late, gets no force, and its search presses it
+            down with the few newtons a free leg's acceleration takes, which
+            never reach the touch threshold (issue 10: on the double pallet
+            both left feet stood on the pallet unloaded for a second while the
+            robot tipped over its right legs).
         """
         cfg = self.config
         planned = np.asarray(planned_contact, dtype=bool)
@@ -115,11 +125,14 @@ class ContactStateMachine:
         # force, but one that has left the ground must not be pushed on (the
         # torques meant for a contact would whirl a free leg).
         holding = normal > cfg.release_force_n
+        grounded = (
+            np.zeros(4, dtype=bool) if on_ground is None else np.asarray(on_ground, dtype=bool)
+        )
         speed = np.asarray(foot_speed, dtype=float)
         for leg in range(4):
             old = self.states[leg]
             if planned[leg]:
-                if touching[leg] or (old.bears_load and holding[leg]):
+                if touching[leg] or grounded[leg] or (old.bears_load and holding[leg]):
                     new = LegContact.STANCE
                 else:
                     new = LegContact.LATE_TOUCHDOWN

@@ -168,11 +168,13 @@ class WholeBodyController:
         self.contact = ContactStateMachine(cfg.contact)
         m = world.model
         self.nv = int(m.nv)
-        self.foot_body = np.asarray(m.geom_bodyid[world.roles.foot], dtype=np.int64)
+        self._foot_geoms = np.asarray(world.roles.foot, dtype=np.int64)
+        self.foot_body = np.asarray(m.geom_bodyid[self._foot_geoms], dtype=np.int64)
         self.foot_radius = float(world.robot.foot_radius)
         self.torques = np.zeros(len(world.joint_dof))
         self.qp_failures = 0
         self.qp_stalls = 0
+        self.qp_relaxed = 0
         self._mass = np.zeros((self.nv, self.nv))
         self._jacp = np.zeros((3, self.nv))
         self._jacdot = np.zeros((3, self.nv))
@@ -212,6 +214,7 @@ class WholeBodyController:
             ref.swing_progress,
             state.foot_forces[:, 2],
             np.linalg.norm(foot_vel[:, :2], axis=1),
+            self._feet_on_ground() if self.config.contact.ground_contact else None,
         )
         stance = np.flatnonzero(estimate.stance)
         _full_mass_matrix(m, d, self._mass)
@@ -235,6 +238,7 @@ class WholeBodyController:
         )
         qp_forces = np.zeros((4, 3))
         if solution.success:
+            self.qp_relaxed += int(solution.relaxed)
             self.torques = solution.tau
             qp_forces[stance] = solution.forces
         else:
@@ -274,6 +278,18 @@ class WholeBodyController:
             current = self.swing_planner.swing(foot, target, ref.t, end)
             self._swings[leg] = current
         return current
+
+    def _feet_on_ground(self) -> NDArray[np.bool_]:
+        """(4,) the foot geom has a contact with the terrain (any force, even none)."""
+        d, roles = self.world.data, self.world.roles
+        on = np.zeros(4, dtype=bool)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            g1, g2 = int(c.geom1), int(c.geom2)
+            other = g2 if g1 == roles.terrain else g1 if g2 == roles.terrain else -1
+            if other >= 0:
+                on |= self._foot_geoms == other
+        return on
 
     def _qacc_bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """(nv,) q̈ bounds keeping q + q̇h + ½q̈h² within the joints' kept range."""

@@ -257,6 +257,10 @@ def _simulate(
         )
         if controller.qp_failures:
             reason += f"; the QP failed on {controller.qp_failures} ticks"
+        if controller.qp_relaxed:
+            reason += (
+                f"; stance feet held by tasks, not constraints, on {controller.qp_relaxed} ticks"
+            )
     else:
         ok = False
     counts = controller.contact.counts

@@ -54,6 +54,9 @@ class QPSolution:
     forces: NDArray[np.float64]
     x: NDArray[np.float64]
     stalled: bool = False
+    relaxed: bool = False
+    """The hard contact rows made the QP infeasible; it was solved with
+    them left to the stance-foot tasks (the cone and torque limits kept)."""
 
 
 def friction_pyramid(normal: ArrayLike, friction: float) -> NDArray[np.float64]:
@@ -162,6 +165,11 @@ class WholeBodyQP:
         contact_bias:
             (3·nc,) J̇_c q̇ [m/s²]: when given, the stance feet do not accelerate,
             J_c q̈ + J̇_c q̇ = 0, as a hard constraint (else it is up to the tasks).
+            When no torque within the limits and no force inside the cones
+            can hold every stance foot still, the QP is solved again without
+            these rows: the stance-foot tasks then ask for it as hard as
+            they can (``relaxed`` in the solution), instead of the tick
+            failing and the previous tick's torques being applied again.
         friction:
             (nc,) μ per stance foot (default: the solver's μ for all).
         qacc_bounds:
@@ -234,6 +242,11 @@ class WholeBodyQP:
         stalled = False
         if x is None:
             x, stalled = self._solve_qp(p, q, g, g_h, a_eq, b_eq, None, None)
+        relaxed = False
+        if x is None and a_eq.shape[0] > nv:
+            # Without the contact rows q̈ is free in M q̈ + h = Sᵀτ + J_cᵀ f: always feasible.
+            x, stalled = self._solve_qp(p, q, g, g_h, a_eq[:nv], b_eq[:nv], None, None)
+            relaxed = x is not None
         if x is None:
             zero = np.zeros(n)
             return QPSolution(
@@ -241,7 +254,9 @@ class WholeBodyQP:
             )
         x = np.asarray(x, dtype=float)
         forces = x[nv + lay.nu :].reshape(nc, 3)
-        return QPSolution(True, x[lay.qacc].copy(), x[lay.tau].copy(), forces.copy(), x)
+        return QPSolution(
+            True, x[lay.qacc].copy(), x[lay.tau].copy(), forces.copy(), x, relaxed=relaxed
+        )
 
     def _solve_qp(
         self,
@@ -307,6 +322,13 @@ class WholeBodyQP:
         solver.settings.eps_rel = 0.0
         solver.settings.max_iter = self.max_iter
         solver.settings.max_iter_in = _PROXQP_MAX_ITER_IN
+        # proxqp's infeasibility test (default 1e-4) is absolute: with forces
+        # of kN and torques of 80 N·m in one vector it declared QPs infeasible
+        # after 3–10 iterations that are feasible by construction (q̈ free in
+        # the dynamics rows alone); issue 10 counted up to 20 such failed
+        # ticks a run, each re-applying the previous torques.
+        solver.settings.eps_primal_inf = _PROXQP_EPS_INFEASIBLE
+        solver.settings.eps_dual_inf = _PROXQP_EPS_INFEASIBLE
         solver.settings.verbose = False
         solver.init(sp.csc_matrix(p), q, sp.csc_matrix(a_eq), b_eq, sp.csc_matrix(c), lower, upper)
         solver.solve()
@@ -322,6 +344,7 @@ class WholeBodyQP:
 # (proxqp's own limits, 10⁴ × 1500, to minutes).
 _DEFAULT_MAX_ITER = {"proxqp": 1000, "osqp": 20000}
 _PROXQP_MAX_ITER_IN = 100
+_PROXQP_EPS_INFEASIBLE = 1e-12
 
 
 def _solver_options(solver: str, max_iter: int) -> dict[str, Any]:
