@@ -29,6 +29,7 @@ import resource
 import shutil
 import subprocess
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -190,17 +191,56 @@ def load(key: str, root: Path | None = None) -> CompiledNlp | None:
             for name in _FUNCTIONS
             if name in meta["functions"]
         }
-        return CompiledNlp(
-            functions=functions,
-            lbg=np.asarray(meta["lbg"], dtype=float),
-            ubg=np.asarray(meta["ubg"], dtype=float),
-            row_layout=[(str(n), int(s)) for n, s in meta["row_layout"]],
-            cost_names=[str(n) for n in meta["cost_names"]],
-            n_variables=int(meta["n_variables"]),
-        )
+        return nlp_of_entry(functions, meta)
     except (OSError, ValueError, KeyError, TypeError, RuntimeError):
         _discard(entry)
         return None
+
+
+def nlp_of_entry(functions: dict[str, ca.Function], meta: dict[str, Any]) -> CompiledNlp:
+    """A loaded entry: its ``functions`` and the layout recorded by :func:`write_entry`."""
+    return CompiledNlp(
+        functions=functions,
+        lbg=np.asarray(meta["lbg"], dtype=float),
+        ubg=np.asarray(meta["ubg"], dtype=float),
+        row_layout=[(str(n), int(s)) for n, s in meta["row_layout"]],
+        cost_names=[str(n) for n in meta["cost_names"]],
+        n_variables=int(meta["n_variables"]),
+    )
+
+
+def write_entry(
+    key: str, base: Path, layout: dict[str, Any], fill: Callable[[Path], dict[str, Any]]
+) -> Path:
+    """Write entry ``key`` under ``base`` whole or not at all; return its path.
+
+    ``fill(folder)`` writes the entry's files into a temporary folder and
+    returns its kind's metadata; the layout (``lbg``, ``ubg``, ``row_layout``,
+    ``cost_names``, ``n_variables``) is added here and the folder renamed into
+    place. When another process stored the key first, its entry is kept.
+    """
+    entry = base / key
+    tmp = Path(tempfile.mkdtemp(prefix=f"{key}.tmp-", dir=base))
+    try:
+        meta = {
+            "key": key,
+            **fill(tmp),
+            "lbg": _bound(layout["lbg"]),
+            "ubg": _bound(layout["ubg"]),
+            "row_layout": [[n, int(s)] for n, s in layout["row_layout"]],
+            "cost_names": list(layout["cost_names"]),
+            "n_variables": int(layout["n_variables"]),
+        }
+        (tmp / _META).write_text(json.dumps(meta))
+        try:
+            tmp.rename(entry)
+        except OSError:
+            # Another process stored this key first: its entry is as good as ours.
+            shutil.rmtree(tmp, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return entry
 
 
 def failed_before(key: str, root: Path | None = None) -> bool:
@@ -241,12 +281,11 @@ def compile_and_store(
     """
     base = root or cache_dir()
     base.mkdir(parents=True, exist_ok=True)
-    entry = base / key
     failed = base / f"{key}{_FAILED}"
     if failed.is_file():
         raise CompileError(f"compiling this NLP failed before: {failed.read_text()[:500]}")
-    tmp = Path(tempfile.mkdtemp(prefix=f"{key}.tmp-", dir=base))
-    try:
+
+    def fill(tmp: Path) -> dict[str, Any]:
         generator = ca.CodeGenerator("nlp.c", _CODEGEN_OPTIONS)
         for name, function in functions.items():
             if function.name() != name:
@@ -268,24 +307,10 @@ def compile_and_store(
             _write_atomic(failed, message, base)
             raise CompileError(f"compiling the NLP failed: {message}") from None
         (tmp / "nlp.c").unlink()
-        meta = {
-            "key": key,
+        return {
             "kind": "compiled",
             "functions": sorted(functions),
             "library_digest": _file_digest(tmp / _LIBRARY),
-            "lbg": _bound(layout["lbg"]),
-            "ubg": _bound(layout["ubg"]),
-            "row_layout": [[n, int(s)] for n, s in layout["row_layout"]],
-            "cost_names": list(layout["cost_names"]),
-            "n_variables": int(layout["n_variables"]),
         }
-        (tmp / _META).write_text(json.dumps(meta))
-        try:
-            tmp.rename(entry)
-        except OSError:
-            # Another process stored this key first: its entry is as good as ours.
-            shutil.rmtree(tmp, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    return entry
+
+    return write_entry(key, base, layout, fill)

@@ -25,17 +25,20 @@ and storing both would read the same graph twice.
 from __future__ import annotations
 
 import json
-import shutil
-import tempfile
 import zlib
 from pathlib import Path
 from typing import Any
 
 import casadi as ca
-import numpy as np
 
 from roughwalk.errors import InvalidArgumentError
-from roughwalk.trajopt.compiled_nlp import CompiledNlp, _bound, _discard, cache_dir
+from roughwalk.trajopt.compiled_nlp import (
+    CompiledNlp,
+    _discard,
+    cache_dir,
+    nlp_of_entry,
+    write_entry,
+)
 
 __all__ = ["KIND", "load", "store"]
 
@@ -94,14 +97,7 @@ def load(key: str, root: Path | None = None) -> CompiledNlp | None:
                 raise ValueError(f"expected function '{name}'")
             functions[name] = function
         functions["nlp"] = _nlp_of(functions["evaluate"])
-        return CompiledNlp(
-            functions=functions,
-            lbg=np.asarray(meta["lbg"], dtype=float),
-            ubg=np.asarray(meta["ubg"], dtype=float),
-            row_layout=[(str(n), int(s)) for n, s in meta["row_layout"]],
-            cost_names=[str(n) for n in meta["cost_names"]],
-            n_variables=int(meta["n_variables"]),
-        )
+        return nlp_of_entry(functions, meta)
     except (OSError, ValueError, KeyError, TypeError, RuntimeError):
         _discard(entry)
         return None
@@ -123,8 +119,8 @@ def store(
     names = sorted(name for name in functions if name != "nlp")
     if "evaluate" not in names:
         raise InvalidArgumentError("a serialised NLP needs its 'evaluate' function")
-    tmp = Path(tempfile.mkdtemp(prefix=f"{key}.tmp-", dir=base))
-    try:
+
+    def fill(tmp: Path) -> dict[str, Any]:
         writer = ca.FileSerializer(str(tmp / _FILE))
         for name in names:
             if functions[name].name() != name:
@@ -133,24 +129,6 @@ def store(
                 )
             writer.pack(functions[name])
         del writer  # flushes and closes the file
-        meta = {
-            "key": key,
-            "kind": KIND,
-            "functions": names,
-            "file_crc32": _checksum(tmp / _FILE),
-            "lbg": _bound(layout["lbg"]),
-            "ubg": _bound(layout["ubg"]),
-            "row_layout": [[n, int(s)] for n, s in layout["row_layout"]],
-            "cost_names": list(layout["cost_names"]),
-            "n_variables": int(layout["n_variables"]),
-        }
-        (tmp / _META).write_text(json.dumps(meta))
-        try:
-            tmp.rename(entry)
-        except OSError:
-            # Another process stored this key first: its entry is as good as ours.
-            shutil.rmtree(tmp, ignore_errors=True)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    return entry
+        return {"kind": KIND, "functions": names, "file_crc32": _checksum(tmp / _FILE)}
+
+    return write_entry(key, base, layout, fill)
