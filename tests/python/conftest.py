@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from functools import cache
 from pathlib import Path
 
@@ -45,3 +45,14 @@ def littledog_board(shared_dir: Path) -> Callable[[str], Terrain]:
 def littledog() -> roughwalk.Robot:
     """Our LittleDog model, loaded once per test module."""
     return roughwalk.load_robot("littledog")
+
+
+@pytest.fixture
+def nlp_cache_dir(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    """An empty NLP cache of the test's own ($ROUGHWALK_CACHE), in-process cache cleared."""
+    from roughwalk.trajopt import clear_cache
+
+    monkeypatch.setenv("ROUGHWALK_CACHE", str(tmp_path))
+    clear_cache()
+    yield tmp_path / "nlp"
+    clear_cache()

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -14,16 +13,8 @@ from roughwalk.trajopt import clear_cache, nlp_cache
 _WARM = ["cache", "warm", "--preset", "towr", "--gait", "trot", "--steps", "4", "--duration", "1"]
 
 
-@pytest.fixture
-def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
-    monkeypatch.setenv("ROUGHWALK_CACHE", str(tmp_path))
-    clear_cache()
-    yield tmp_path / "nlp"
-    clear_cache()
-
-
 def test_warm_list_and_clear(
-    cache: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    nlp_cache_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     assert main(["cache", "list"]) == 0
     assert "0 entries" in capsys.readouterr().out
@@ -40,20 +31,23 @@ def test_warm_list_and_clear(
     (entry,) = json.loads(listing.read_text())["entries"]
     assert entry["kind"] == "serialized"
     assert entry["n_variables"] > 0
-    assert entry["size_bytes"] == sum(p.stat().st_size for p in (cache / entry["key"]).iterdir())
+    files = (nlp_cache_dir / entry["key"]).iterdir()
+    assert entry["size_bytes"] == sum(p.stat().st_size for p in files)
 
     # A crashed writer's leftover (no metadata) is listed as such.
-    (cache / "0123abcd").mkdir()
+    (nlp_cache_dir / "0123abcd").mkdir()
     assert {e.kind for e in nlp_cache.entries()} == {"serialized", "unreadable"}
 
     assert main(["cache", "clear", "--kind", "compiled"]) == 0
     assert "removed 0 entries" in capsys.readouterr().out
     assert main(["cache", "clear"]) == 0
     assert "removed 2 entries" in capsys.readouterr().out
-    assert list(cache.iterdir()) == []
+    assert list(nlp_cache_dir.iterdir()) == []
 
 
-def test_warm_reports_a_bad_structure(cache: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_warm_reports_a_bad_structure(
+    nlp_cache_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     # Four swings cannot fit in 0.1 s: nothing is built or stored.
     args = ["cache", "warm", "--preset", "towr", "--gait", "trot", "--steps", "4"]
     assert main([*args, "--duration", "0.1"]) == 1

@@ -5,7 +5,6 @@ from __future__ import annotations
 import subprocess
 import sys
 import textwrap
-from collections.abc import Iterator
 from pathlib import Path
 
 import casadi as ca
@@ -30,14 +29,6 @@ _TASK = ((0.0, 0.0, 0.0), (0.3, 0.0, 0.0))
 _PROBLEM = {"gait": "trot", "steps": 4, "duration": 1.0, "max_iter": 5}
 
 
-@pytest.fixture
-def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
-    monkeypatch.setenv("ROUGHWALK_CACHE", str(tmp_path))
-    clear_cache()
-    yield tmp_path / "nlp"
-    clear_cache()
-
-
 def _solve(compiled: str, **changes: object) -> TrajoptResult:
     clear_cache()
     config = towr_config(body_model="towr_anymal", **changes)
@@ -54,12 +45,12 @@ def _same(a: TrajoptResult, b: TrajoptResult) -> None:
 
 @pytest.mark.parametrize("changes", [{}, {"optimize_durations": True}])
 def test_a_deserialized_nlp_solves_exactly_as_the_expressions_do(
-    cache: Path, changes: dict[str, object]
+    nlp_cache_dir: Path, changes: dict[str, object]
 ) -> None:
     expression = _solve("off", **changes)
     stored = _solve("auto", **changes)
     assert stored.build == "serialized"
-    (entry,) = cache.iterdir()
+    (entry,) = nlp_cache_dir.iterdir()
     assert (entry / "nlp.casadi").is_file()
     loaded = _solve("auto", **changes)
     assert loaded.build == "deserialized"
@@ -68,21 +59,21 @@ def test_a_deserialized_nlp_solves_exactly_as_the_expressions_do(
         assert result.violations.keys() == expression.violations.keys()
 
 
-def test_the_exact_hessian_is_stored_with_costs(cache: Path) -> None:
+def test_the_exact_hessian_is_stored_with_costs(nlp_cache_dir: Path) -> None:
     # Melon's costs select the exact Hessian: it is stored and read back too.
     costs = CostWeights()
     expression = _solve("off", costs=costs)
     assert _solve("auto", costs=costs).build == "serialized"
     loaded = _solve("auto", costs=costs)
     assert loaded.build == "deserialized"
-    (entry,) = cache.iterdir()
+    (entry,) = nlp_cache_dir.iterdir()
     assert "nlp_hess_l" in (entry / "meta.json").read_text()
     _same(loaded, expression)
 
 
-def test_a_damaged_or_partial_entry_is_removed_and_rebuilt(cache: Path) -> None:
+def test_a_damaged_or_partial_entry_is_removed_and_rebuilt(nlp_cache_dir: Path) -> None:
     _solve("auto")
-    (entry,) = cache.iterdir()
+    (entry,) = nlp_cache_dir.iterdir()
     data = entry / "nlp.casadi"
     data.write_bytes(data.read_bytes()[:-100])  # truncated
     assert serialized_nlp.load(entry.name) is None
