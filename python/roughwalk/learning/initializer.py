@@ -147,6 +147,31 @@ class LearnedInitializer:
             return None, None
         return lam_x[0], _complete_rows(nlp, lam_g[0])
 
+    def has_fallback(self, nlp: Formulation) -> bool:
+        """Whether :meth:`fallback` differs from the guess: the model has a solution library."""
+        if self.model is None:
+            self.model = _pick(problem_signature(nlp))
+        return self.model.library is not None
+
+    def fallback(
+        self, nlp: Formulation, task: ResolvedTask
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]:
+        """The network's own guess and multipliers, for a library pick that does not converge.
+
+        A library pick is a solution of a neighbouring task; when it lies in
+        a basin IPOPT does not leave for this task, the network's guess (an
+        average over neighbours, in no one basin) often converges: see
+        ``solver.guess_fallback_after``.
+        """
+        if self.model is None:
+            self.model = _pick(problem_signature(nlp))
+        network = self.model.network_only()
+        x0 = np.clip(network.predict(task.task), nlp.lbx, nlp.ubx)
+        lam_x, lam_g = network.predict_multipliers([task.task])
+        if lam_x is None or lam_g is None:
+            return x0, None, None
+        return x0, lam_x[0], _complete_rows(nlp, lam_g[0])
+
 
 def _complete_rows(nlp: Formulation, lam_g: NDArray[np.float64]) -> NDArray[np.float64]:
     """``lam_g`` for every row of ``nlp``: zeros for constraints appended after the model's.
