@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from roughwalk.errors import ConfigError
 from roughwalk.learning.dataset import COLUMNS, Dataset
 from roughwalk.learning.executors import Executor, LocalExecutor
+from roughwalk.learning.model_costs import cost_changes
 from roughwalk.learning.problem_spec import ProblemSpec, build_problem, variable_layout
 from roughwalk.learning.task_space import TaskSpace
 from roughwalk.trajopt import (
@@ -353,6 +354,8 @@ def generate(
             # A run resumed under another constraint set would mix two problems'
             # solves; checked first, so that the refusal names it.
             "constraints": list(spec.config().constraints),
+            # Only when some weight is not the default: older runs resume as before.
+            **({"costs": costs} if (costs := cost_changes(spec.config().costs)) else {}),
             "problem": spec.to_dict(),
             "task_space": space.to_dict(),
             "split": split,

@@ -16,9 +16,11 @@ from numpy.typing import NDArray
 
 from roughwalk.errors import ConfigError
 from roughwalk.learning.model_constraints import constraints_for_model
+from roughwalk.learning.model_costs import costs_for_model
 from roughwalk.learning.model_file import LearnedModel, problem_signature
 from roughwalk.learning.problem_spec import ProblemSpec
 from roughwalk.trajopt import ContactSchedule, Formulation, register_initializer
+from roughwalk.trajopt.parameters import CostWeights
 from roughwalk.trajopt.task import ResolvedTask
 
 __all__ = ["LearnedInitializer", "MODELS_DIR", "shipped_models", "load_model", "model_for_spec"]
@@ -127,6 +129,16 @@ class LearnedInitializer:
         if self.model is None:
             self.model = _pick(signature)
         return constraints_for_model(self.model, requested)
+
+    def costs(self, requested: CostWeights, signature: dict[str, object]) -> CostWeights:
+        """The cost weights to solve with: the model's recorded ones where none was chosen.
+
+        A weight the configuration changed from the default is kept (the
+        user's override wins); see :mod:`.model_costs`.
+        """
+        if self.model is None:
+            self.model = _pick(signature)
+        return costs_for_model(self.model, requested)
 
     def guess(self, nlp: Formulation, task: ResolvedTask) -> NDArray[np.float64]:
         """A_θ(task), within the NLP's variable bounds; refuses a problem the model does not fit."""

@@ -538,6 +538,17 @@ def optimize_motion(
         chosen = tuple(choose(tuple(cfg.constraints), signature))
         if chosen != tuple(cfg.constraints):
             cfg = replace(cfg, constraints=chosen)
+        # ... and to the cost weights it was trained with (weights the caller set win).
+        weigh = getattr(initializer, "costs", None)
+        if callable(weigh):
+            weights = weigh(cfg.costs, signature)
+            if weights != cfg.costs:
+                cfg = replace(cfg, costs=weights)
+                terrain_model, _ = _cached(
+                    _terrains,
+                    (_terrain_key(terrain_obj), cfg.terrain, cfg.costs.step_edge_sigma),
+                    lambda: TerrainModel(terrain_obj, cfg.terrain, cfg.costs.step_edge_sigma),
+                )
     problems = _schedule_problems(schedule, cfg)
     problems += stance_problems(body, terrain_model, the_task.start, "start")
     problems += stance_problems(body, terrain_model, the_task.goal, "goal")
