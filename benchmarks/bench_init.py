@@ -62,6 +62,7 @@ from roughwalk.learning import (
 )
 from roughwalk.learning.filtering import cost_threshold, feasible_mask
 from roughwalk.learning.model_constraints import constraints_for_model
+from roughwalk.learning.model_costs import cost_changes, costs_for_model
 from roughwalk.trajopt import HeuristicInitializer, TrajoptProblem
 
 RESULTS = Path(__file__).resolve().parent / "results"
@@ -123,21 +124,28 @@ def _summary(
 
 
 def _set_suffix(spec: ProblemSpec) -> str:
-    """A run folder's suffix naming a constraint set other than the default ("" for it)."""
+    """A run folder's suffix naming a constraint set and cost weights other than the defaults."""
+    weights = "".join(f"_{k}{v:g}" for k, v in spec.costs or ())
     if spec.constraints is None:
-        return ""
+        return weights
     default = ProblemSpec().config().constraints
     extra = [c for c in spec.constraints if c not in default]
-    return "_with_" + "_".join(extra) if extra else "_" + "_".join(spec.constraints)
+    return ("_with_" + "_".join(extra) if extra else "_" + "_".join(spec.constraints)) + weights
 
 
 def spec_of_models(env: str, models: list[tuple[str, LearnedModel]]) -> ProblemSpec:
-    """The held-out problem: every initialiser solves the newest model's constraint set."""
+    """The held-out problem: every initialiser solves the newest model's constraints and costs."""
     spec = ProblemSpec("anymal_c", env, "walk", 16, 5.5)
     if not models:
         return spec
-    chosen = constraints_for_model(models[-1][1], spec.config().constraints)
-    return spec if chosen == spec.config().constraints else replace(spec, constraints=chosen)
+    model = models[-1][1]
+    chosen = constraints_for_model(model, spec.config().constraints)
+    if chosen != spec.config().constraints:
+        spec = replace(spec, constraints=chosen)
+    weights = costs_for_model(model, spec.config().costs)
+    if weights != spec.config().costs:
+        spec = replace(spec, costs=tuple(sorted(cost_changes(weights).items())))
+    return spec
 
 
 def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:

@@ -177,3 +177,19 @@ def test_cli_trains_a_model_that_optimize_uses(experience: Path, tmp_path: Path)
         )
         == 1
     )
+
+
+def test_training_copies_the_run_s_cost_weights_into_the_header(
+    experience: Path, tmp_path: Path
+) -> None:
+    from roughwalk.learning.experience import read_run
+    from roughwalk.learning.model_costs import recorded_costs
+
+    data = read_run(experience)
+    assert "costs" not in data.meta  # solved with the default weights
+    plain, _ = train_model(data, layers=(4,), max_epochs=5)
+    assert recorded_costs(plain) is None
+    data.meta["costs"] = {"force_between_nodes_penalty": 10.0}
+    model, _ = train_model(data, layers=(4,), max_epochs=5)
+    loaded = LearnedModel.load(model.save(tmp_path / "penalty.npz"))
+    assert recorded_costs(loaded) == {"force_between_nodes_penalty": 10.0}

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from roughwalk.errors import ConfigError
 from roughwalk.learning.dataset import COLUMNS, Dataset
 from roughwalk.learning.executors import Executor, LocalExecutor
+from roughwalk.learning.model_costs import cost_changes
 from roughwalk.learning.problem_spec import ProblemSpec, build_problem, variable_layout
 from roughwalk.learning.task_space import TaskSpace
 from roughwalk.trajopt import (
@@ -68,10 +69,19 @@ class SolveJob:
     x0: NDArray[np.float64] | None = None
     lam_x0: NDArray[np.float64] | None = None
     lam_g0: NDArray[np.float64] | None = None
+    fallback: (
+        tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None] | None
+    ) = None
+    """A second start (guess, lam_x, lam_g): a library model's network guess."""
 
 
 class FixedGuess:
-    """An initialiser that hands over a given guess (and multipliers)."""
+    """An initialiser that hands over a given guess (and multipliers), and a fallback if given.
+
+    The fallback (a library model's network guess and multipliers) is the
+    start of a restart when the solve from ``x0`` has not converged after
+    ``solver.guess_fallback_after`` iterations, as under ``--init learned``.
+    """
 
     name = "fixed"
 
@@ -80,8 +90,28 @@ class FixedGuess:
         x0: NDArray[np.float64],
         lam_x0: NDArray[np.float64] | None = None,
         lam_g0: NDArray[np.float64] | None = None,
+        fallback: (
+            tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]
+            | None
+        ) = None,
     ) -> None:
         self.x0, self.lam_x0, self.lam_g0 = x0, lam_x0, lam_g0
+        self._fallback = fallback
+
+    def has_fallback(self, nlp: Formulation) -> bool:
+        """Whether a fallback start was given."""
+        return self._fallback is not None
+
+    def fallback(
+        self, nlp: Formulation, task: ResolvedTask
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]:
+        """The fallback start, within the bounds, lam_g padded for appended rows."""
+        from roughwalk.learning.initializer import _complete_rows
+
+        assert self._fallback is not None
+        x1, lam_x1, lam_g1 = self._fallback
+        lam_g = None if lam_g1 is None else _complete_rows(nlp, np.asarray(lam_g1))
+        return np.clip(np.asarray(x1, dtype=float), nlp.lbx, nlp.ubx), lam_x1, lam_g
 
     def schedule(self, gait: ContactSchedule) -> ContactSchedule:
         """The gait's schedule."""
@@ -132,6 +162,23 @@ def result_row(index: int, result: TrajoptResult, x0: NDArray[np.float64]) -> di
     }
 
 
+def _network_starts(
+    model: LearnedModel, tasks: list[Task]
+) -> list[
+    tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None] | None
+]:
+    """Per task the network's own guess and multipliers: a library model's fallback."""
+    if model.library is None:
+        return [None] * len(tasks)
+    network = model.network_only()
+    x = network.predict_tasks(tasks)
+    lam_x, lam_g = network.predict_multipliers(tasks)
+    return [
+        (x[k], None if lam_x is None else lam_x[k], None if lam_g is None else lam_g[k])
+        for k in range(len(tasks))
+    ]
+
+
 def solve_job(job: SolveJob) -> dict[str, Any]:
     """Solve one job in this process (the NLP is built once per process)."""
     problem = build_problem(job.spec)
@@ -140,7 +187,7 @@ def solve_job(job: SolveJob) -> dict[str, Any]:
         x0 = HeuristicInitializer().guess(problem.formulation, resolved)
     else:
         x0 = np.asarray(job.x0, dtype=float)
-    guess = FixedGuess(x0, job.lam_x0, job.lam_g0)
+    guess = FixedGuess(x0, job.lam_x0, job.lam_g0, job.fallback)
     result = problem.solve(job.task, guess, max_iter=job.max_iter)
     return result_row(job.index, result, x0)
 
@@ -307,6 +354,8 @@ def generate(
             # A run resumed under another constraint set would mix two problems'
             # solves; checked first, so that the refusal names it.
             "constraints": list(spec.config().constraints),
+            # Only when some weight is not the default: older runs resume as before.
+            **({"costs": costs} if (costs := cost_changes(spec.config().costs)) else {}),
             "problem": spec.to_dict(),
             "task_space": space.to_dict(),
             "split": split,
@@ -328,6 +377,7 @@ def generate(
         asked = tasks if jitter is None else jittered(tasks, todo, jitter, jitter_seed)
         x0s = model.predict_tasks(asked)
         lam_x, lam_g = model.predict_multipliers(asked)
+        fallbacks = _network_starts(model, asked)
         jobs = [
             SolveJob(
                 spec,
@@ -337,6 +387,7 @@ def generate(
                 x0s[k],
                 None if lam_x is None else lam_x[k],
                 None if lam_g is None else lam_g[k],
+                fallbacks[k],
             )
             for k, job in enumerate(jobs)
         ]

@@ -16,9 +16,11 @@ from numpy.typing import NDArray
 
 from roughwalk.errors import ConfigError
 from roughwalk.learning.model_constraints import constraints_for_model
+from roughwalk.learning.model_costs import costs_for_model
 from roughwalk.learning.model_file import LearnedModel, problem_signature
 from roughwalk.learning.problem_spec import ProblemSpec
 from roughwalk.trajopt import ContactSchedule, Formulation, register_initializer
+from roughwalk.trajopt.parameters import CostWeights
 from roughwalk.trajopt.task import ResolvedTask
 
 __all__ = ["LearnedInitializer", "MODELS_DIR", "shipped_models", "load_model", "model_for_spec"]
@@ -128,6 +130,16 @@ class LearnedInitializer:
             self.model = _pick(signature)
         return constraints_for_model(self.model, requested)
 
+    def costs(self, requested: CostWeights, signature: dict[str, object]) -> CostWeights:
+        """The cost weights to solve with: the model's recorded ones where none was chosen.
+
+        A weight the configuration changed from the default is kept (the
+        user's override wins); see :mod:`.model_costs`.
+        """
+        if self.model is None:
+            self.model = _pick(signature)
+        return costs_for_model(self.model, requested)
+
     def guess(self, nlp: Formulation, task: ResolvedTask) -> NDArray[np.float64]:
         """A_θ(task), within the NLP's variable bounds; refuses a problem the model does not fit."""
         signature = problem_signature(nlp)
@@ -146,6 +158,31 @@ class LearnedInitializer:
         if lam_x is None or lam_g is None:
             return None, None
         return lam_x[0], _complete_rows(nlp, lam_g[0])
+
+    def has_fallback(self, nlp: Formulation) -> bool:
+        """Whether :meth:`fallback` differs from the guess: the model has a solution library."""
+        if self.model is None:
+            self.model = _pick(problem_signature(nlp))
+        return self.model.library is not None
+
+    def fallback(
+        self, nlp: Formulation, task: ResolvedTask
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]:
+        """The network's own guess and multipliers, for a library pick that does not converge.
+
+        A library pick is a solution of a neighbouring task; when it lies in
+        a basin IPOPT does not leave for this task, the network's guess (an
+        average over neighbours, in no one basin) often converges: see
+        ``solver.guess_fallback_after``.
+        """
+        if self.model is None:
+            self.model = _pick(problem_signature(nlp))
+        network = self.model.network_only()
+        x0 = np.clip(network.predict(task.task), nlp.lbx, nlp.ubx)
+        lam_x, lam_g = network.predict_multipliers([task.task])
+        if lam_x is None or lam_g is None:
+            return x0, None, None
+        return x0, lam_x[0], _complete_rows(nlp, lam_g[0])
 
 
 def _complete_rows(nlp: Formulation, lam_g: NDArray[np.float64]) -> NDArray[np.float64]:

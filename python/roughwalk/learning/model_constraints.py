@@ -45,23 +45,28 @@ def constraints_for_model(model: LearnedModel, requested: tuple[str, ...]) -> tu
 
 
 def spec_for_learned(spec: ProblemSpec) -> ProblemSpec:
-    """``spec`` with the constraint set of the shipped model that fits it.
+    """``spec`` with the constraint set and cost weights of the shipped model that fits it.
 
-    A spec that names its set keeps it; one without a fitting shipped model
-    is returned unchanged (the heuristic then solves the default set).
+    A spec that names its set keeps it, and the weights it names (see
+    :mod:`.model_costs`); one without a fitting shipped model is returned
+    unchanged (the heuristic then solves the default NLP).
     """
     from dataclasses import replace
 
     from roughwalk.errors import ConfigError
     from roughwalk.learning.initializer import model_for_spec
+    from roughwalk.learning.model_costs import cost_changes, costs_for_model
 
-    if spec.constraints is not None:
-        return spec
     try:
         model = model_for_spec("learned", spec)
     except ConfigError:
         return spec
-    chosen = constraints_for_model(model, spec.config().constraints)
-    if chosen == spec.config().constraints:
-        return spec
-    return replace(spec, constraints=chosen)
+    config = spec.config()
+    changes: dict[str, Any] = {}
+    chosen = constraints_for_model(model, config.constraints)
+    if spec.constraints is None and chosen != config.constraints:
+        changes["constraints"] = chosen
+    weights = costs_for_model(model, config.costs)
+    if weights != config.costs:
+        changes["costs"] = tuple(sorted(cost_changes(weights).items()))
+    return replace(spec, **changes) if changes else spec

@@ -88,6 +88,12 @@ class LearnedModel:
         self.multiplier_mlp = multipliers
         self.library = library
 
+    def network_only(self) -> LearnedModel:
+        """The model without its solution library: the networks' guesses and multipliers."""
+        if self.library is None:
+            return self
+        return LearnedModel(self.mlp, self.header, self.multiplier_mlp, None)
+
     @property
     def name(self) -> str:
         """The model's name (its file's stem when loaded)."""

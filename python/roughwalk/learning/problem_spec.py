@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from roughwalk.config import override
 from roughwalk.errors import ConfigError
 from roughwalk.trajopt import (
     Formulation,
@@ -72,6 +73,10 @@ class ProblemSpec:
         The NLP's constraint names; None: :func:`~roughwalk.trajopt.melon_config`'s
         default set (left out of :meth:`to_dict` then, so that runs recorded
         before the field existed still resume).
+    costs:
+        Cost weights that differ from ``melon_config``'s, as (dotted name,
+        value) pairs (("force_between_nodes_penalty", 10.0),); None: the
+        default weights (left out of :meth:`to_dict` then, as ``constraints``).
 
     """
 
@@ -82,27 +87,35 @@ class ProblemSpec:
     duration: float = 5.5
     optimize_durations: bool = False
     constraints: tuple[str, ...] | None = None
+    costs: tuple[tuple[str, float], ...] | None = None
 
     def config(self) -> TrajoptConfig:
         """Melon et al.'s configuration for this problem."""
         changes: dict[str, object] = {}
         if self.constraints is not None:
             changes["constraints"] = tuple(self.constraints)
-        return melon_config(
+        config = melon_config(
             gait=self.gait,
             steps=self.steps,
             duration=self.duration,
             optimize_durations=self.optimize_durations,
             **changes,
         )
+        if self.costs:
+            config = override(config, {f"costs.{k}": v for k, v in self.costs})
+        return config
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data for JSON (``constraints`` only when not the default set)."""
+        """Plain data for JSON (``constraints`` and ``costs`` only when not the defaults)."""
         data = asdict(self)
         if self.constraints is None:
             del data["constraints"]
         else:
             data["constraints"] = list(self.constraints)
+        if self.costs is None:
+            del data["costs"]
+        else:
+            data["costs"] = dict(self.costs)
         return data
 
     @classmethod
@@ -119,6 +132,9 @@ class ProblemSpec:
                 constraints=None
                 if data.get("constraints") is None
                 else tuple(str(c) for c in data["constraints"]),
+                costs=None
+                if data.get("costs") is None
+                else tuple(sorted((str(k), float(v)) for k, v in data["costs"].items())),
             )
         except KeyError as e:
             raise ConfigError(f"problem spec lacks the field {e}; got {sorted(data)}") from None

@@ -272,6 +272,7 @@ def train_model(
         "version": MODEL_VERSION,
         "problem": spec.to_dict(),
         "constraints": data.meta.get("constraints"),
+        "costs": data.meta.get("costs"),
         "task_space": data.meta.get("task_space"),
         "layout": [list(item) for item in data.meta["layout"]],
         "features": list(FEATURES),

@@ -32,12 +32,19 @@ from roughwalk.trajopt.result import Splines, TrajoptResult
 from roughwalk.trajopt.robot_model import SingleRigidBody, rigid_body_model
 from roughwalk.trajopt.solver import (
     IterationInfo,
+    SolveOutcome,
     TrajoptSolver,
     TrajoptStatus,
     hessian_choice,
     violation,
 )
-from roughwalk.trajopt.task import Task, level_stance_problems, resolve, stance_problems
+from roughwalk.trajopt.task import (
+    ResolvedTask,
+    Task,
+    level_stance_problems,
+    resolve,
+    stance_problems,
+)
 from roughwalk.trajopt.terrain_model import TerrainModel
 from roughwalk.trajopt.variables import NumericSpline
 
@@ -192,17 +199,73 @@ class TrajoptProblem:
                 )
         build = self.build_time_s if self._build_pending else 0.0
         self._build_pending = False
-        outcome = self.solver.solve(
+        limit = self.config.solver.max_iter if max_iter is None else int(max_iter)
+        seconds = self.config.solver.time_limit_s if time_limit_s is None else time_limit_s
+        after = self.config.solver.guess_fallback_after
+        has_fallback = getattr(initializer, "has_fallback", None)
+        falls_back = (
+            predicted
+            and after is not None
+            and after < limit
+            and callable(has_fallback)
+            and bool(has_fallback(nlp))
+        )
+        outcome = self._solve_from(
+            resolved,
+            x0,
+            lam_x,
+            lam_g,
+            min(limit, after) if falls_back and after is not None else limit,
+            seconds,
+            callback,
+            predicted,
+        )
+        if falls_back and _restartable(outcome.status):
+            x1, lam_x1, lam_g1 = initializer.fallback(nlp, resolved)  # type: ignore[attr-defined]
+            second = self._solve_from(
+                resolved,
+                x1,
+                lam_x1,
+                lam_g1,
+                limit - outcome.iterations,
+                max(seconds - outcome.solve_time_s, 1e-3),
+                callback,
+                predicted,
+            )
+            result = self._result(task, _joined(outcome, second, nlp), build, extra_time_s)
+            result.message += (
+                f"; restarted from the initialiser's fallback guess after "
+                f"{outcome.iterations} iterations from its first"
+            )
+            return result
+        return self._result(task, outcome, build, extra_time_s)
+
+    def _solve_from(
+        self,
+        resolved: ResolvedTask,
+        x0: NDArray[np.float64],
+        lam_x: NDArray[np.float64] | None,
+        lam_g: NDArray[np.float64] | None,
+        max_iter: int,
+        time_limit_s: float,
+        callback: Callable[[IterationInfo], bool | None] | None,
+        predicted: bool,
+    ) -> SolveOutcome:
+        """One IPOPT solve; multipliers of the wrong size are dropped."""
+        return self.solver.solve(
             resolved.vector(),
             x0,
             max_iter=max_iter,
             time_limit_s=time_limit_s,
             callback=callback,
             lam_x0=lam_x if lam_x is not None and lam_x.size == x0.size else None,
-            lam_g0=lam_g if lam_g is not None and lam_g.size == nlp.n_constraints else None,
+            lam_g0=(
+                lam_g
+                if lam_g is not None and lam_g.size == self.formulation.n_constraints
+                else None
+            ),
             predicted=predicted,
         )
-        return self._result(task, outcome, build, extra_time_s)
 
     def _result(self, task: Task, outcome: Any, build: float, extra: float) -> TrajoptResult:
         nlp = self.formulation
@@ -251,6 +314,39 @@ class TrajoptProblem:
             lam_g=outcome.lam_g,
             terrain=self.terrain.name,
         )
+
+
+def _restartable(status: TrajoptStatus) -> bool:
+    """Whether a first solve that ended with ``status`` is restarted from the fallback."""
+    return not status.solved and status not in (TrajoptStatus.CANCELLED, TrajoptStatus.TIMEOUT)
+
+
+def _joined(first: SolveOutcome, second: SolveOutcome, nlp: Formulation) -> SolveOutcome:
+    """The restart's outcome, unless the first ended nearer feasible; both solves' cost.
+
+    Iterations and time are the sum of both solves (the restart is paid for);
+    the history runs on, the restart's iterations numbered after the first's.
+    """
+    chosen = second
+    if not second.status.solved and _max_violation(first, nlp) < _max_violation(second, nlp):
+        chosen = first
+    history = list(first.history) + [
+        {**h, "iteration": h.get("iteration", 0) + first.iterations} for h in second.history
+    ]
+    return replace(
+        chosen,
+        iterations=first.iterations + second.iterations,
+        solve_time_s=first.solve_time_s + second.solve_time_s,
+        history=history,
+    )
+
+
+def _max_violation(outcome: SolveOutcome, nlp: Formulation) -> float:
+    """Largest constraint or bound violation of ``outcome``'s point."""
+    if not np.isfinite(outcome.x).all():
+        return float("inf")
+    rows = violation(outcome.g, nlp.lbg, nlp.ubg).max(initial=0.0)
+    return float(max(rows, violation(outcome.x, nlp.lbx, nlp.ubx).max(initial=0.0)))
 
 
 def _splines(
@@ -442,6 +538,17 @@ def optimize_motion(
         chosen = tuple(choose(tuple(cfg.constraints), signature))
         if chosen != tuple(cfg.constraints):
             cfg = replace(cfg, constraints=chosen)
+        # ... and to the cost weights it was trained with (weights the caller set win).
+        weigh = getattr(initializer, "costs", None)
+        if callable(weigh):
+            weights = weigh(cfg.costs, signature)
+            if weights != cfg.costs:
+                cfg = replace(cfg, costs=weights)
+                terrain_model, _ = _cached(
+                    _terrains,
+                    (_terrain_key(terrain_obj), cfg.terrain, cfg.costs.step_edge_sigma),
+                    lambda: TerrainModel(terrain_obj, cfg.terrain, cfg.costs.step_edge_sigma),
+                )
     problems = _schedule_problems(schedule, cfg)
     problems += stance_problems(body, terrain_model, the_task.start, "start")
     problems += stance_problems(body, terrain_model, the_task.goal, "goal")

@@ -4,7 +4,11 @@ An initialiser may change the contact schedule (a footstep plan brings its
 own) and the task's start (the plan's first stance), then gives the initial
 variable vector. One with a ``constraints(requested, signature)`` method also
 chooses the constraint set (:func:`~roughwalk.trajopt.optimize_motion` asks
-it): a learned model's guess belongs to the set it was trained on. Other
+it): a learned model's guess belongs to the set it was trained on; one
+with ``costs(requested, signature)`` likewise chooses the cost weights. One
+with ``has_fallback(nlp)`` and ``fallback(nlp, task)`` offers a second
+start (guess and multipliers) for a solve from its guess that has not
+converged after ``solver.guess_fallback_after`` iterations. Other
 wings add theirs with :func:`register_initializer`; the learning wing
 registers ``learned`` (Melon 2020, §IV) when it is imported, since this wing
 may not import the wings above it.

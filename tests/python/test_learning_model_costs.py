@@ -1,0 +1,99 @@
+"""A learned guess is solved with the cost weights its model was trained with."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+import roughwalk
+from roughwalk.config import override
+from roughwalk.learning import LearnedModel, ProblemSpec, build_problem, task_space
+from roughwalk.learning.experience import generate
+from roughwalk.learning.mlp import MLP
+from roughwalk.learning.model_costs import cost_changes, costs_for_model, recorded_costs
+from roughwalk.learning.model_file import MODEL_FORMAT, problem_signature
+from roughwalk.trajopt import HeuristicInitializer, Task
+from roughwalk.trajopt.parameters import melon_config
+from roughwalk.trajopt.task import resolve
+
+SPEC = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0)
+PENALTY = {"force_between_nodes_penalty": 10.0}
+
+
+def _model(costs: dict[str, float] | None) -> LearnedModel:
+    """A model whose every prediction is the heuristic's guess of one task (a sane start)."""
+    problem = build_problem(SPEC)
+    nlp = problem.formulation
+    n_out = nlp.n_variables
+    guess = HeuristicInitializer().guess(
+        nlp, resolve(Task((0, 0, 0), (0.4, 0, 0)), problem.body, problem.terrain)
+    )
+    weights = (np.zeros((6, 5), np.float32), np.zeros((5, n_out), np.float32))
+    biases = (np.zeros(5, np.float32), np.zeros(n_out, np.float32))
+    mlp = MLP(weights, biases, "tanh", np.zeros(6), np.ones(6), guess, np.ones(n_out))
+    header: dict[str, object] = {
+        "format": MODEL_FORMAT,
+        "version": 1,
+        "problem": SPEC.to_dict(),
+        "layout": problem_signature(nlp)["layout"],
+    }
+    if costs is not None:
+        header["costs"] = costs
+    return LearnedModel(mlp, header)
+
+
+def test_recorded_weights_survive_a_save_and_load(tmp_path: Path) -> None:
+    loaded = LearnedModel.load(_model(PENALTY).save(tmp_path / "penalty.npz"))
+    assert recorded_costs(loaded) == PENALTY
+    old = LearnedModel.load(_model(None).save(tmp_path / "old.npz"))
+    assert recorded_costs(old) is None
+    assert costs_for_model(old, melon_config().costs) == melon_config().costs
+
+
+def test_recorded_weights_replace_defaults_but_not_chosen_ones() -> None:
+    model = _model({"force_between_nodes_penalty": 10.0, "force.weight": 0.2})
+    default = melon_config().costs
+    applied = costs_for_model(model, default)
+    assert applied.force_between_nodes_penalty == 10.0
+    assert applied.force.weight == 0.2
+    assert cost_changes(applied) == {"force_between_nodes_penalty": 10.0, "force.weight": 0.2}
+    chosen = costs_for_model(model, override(melon_config().costs, {"force.weight": 0.07}))
+    assert chosen.force.weight == 0.07
+    assert chosen.force_between_nodes_penalty == 10.0
+
+
+def test_a_solve_from_the_model_uses_the_recorded_weight_unless_overridden(
+    tmp_path: Path,
+) -> None:
+    path = _model(PENALTY).save(tmp_path / "penalty.npz")
+    problem = {"gait": "walk", "steps": 4, "duration": 2.0, "max_iter": 0}
+    task = ((0, 0, 0), (0.4, 0, 0))
+    result = roughwalk.optimize_motion("anymal_c", "flat", task, init=f"learned:{path}", **problem)
+    assert result.config["costs"]["force_between_nodes_penalty"] == 10.0
+    assert "force_between_nodes_penalty" in result.costs
+    mine = roughwalk.optimize_motion(
+        "anymal_c",
+        "flat",
+        task,
+        init=f"learned:{path}",
+        costs__force_between_nodes_penalty=3.0,
+        **problem,
+    )
+    assert mine.config["costs"]["force_between_nodes_penalty"] == 3.0
+    plain = roughwalk.optimize_motion("anymal_c", "flat", task, init="heuristic", **problem)
+    assert plain.config["costs"]["force_between_nodes_penalty"] == 0.0
+    assert "force_between_nodes_penalty" not in plain.costs  # the term exists only if weighed
+
+
+def test_a_spec_s_weights_reach_its_config_and_the_run_record(tmp_path: Path) -> None:
+    spec = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0, costs=tuple(PENALTY.items()))
+    assert spec.config().costs.force_between_nodes_penalty == 10.0
+    assert ProblemSpec.from_dict(spec.to_dict()) == spec
+    assert "costs" not in SPEC.to_dict()
+    generate(spec, task_space("flat"), 0, tmp_path / "run", split="test", progress=None)
+    meta = json.loads((tmp_path / "run" / "run.json").read_text())
+    assert meta["costs"] == PENALTY
+    generate(SPEC, task_space("flat"), 0, tmp_path / "plain", split="test", progress=None)
+    assert "costs" not in json.loads((tmp_path / "plain" / "run.json").read_text())
