@@ -19,7 +19,7 @@ from roughwalk.trajopt import (
     valid_step_counts,
 )
 from roughwalk.trajopt.task import Task, resolve
-from roughwalk.trajopt.variables import NodeSpline, NumericSpline, hermite_point
+from roughwalk.trajopt.variables import NodeSpline, NumericSpline, PhaseDurations, hermite_point
 
 
 @pytest.fixture(scope="module")
@@ -165,6 +165,40 @@ def test_symbolic_durations_pick_the_right_polynomial() -> None:
         np.testing.assert_allclose(values[0:3, ok].T, p[ok], atol=1e-10)
         np.testing.assert_allclose(values[3:6, ok].T, v[ok], atol=1e-10)
         np.testing.assert_allclose(values[6:9, ok].T, a[ok], atol=1e-9)
+
+
+def test_polynomial_windows_hold_every_admissible_schedule() -> None:
+    # A spline sample only selects among the polynomials whose window holds
+    # it: at any durations within their bounds (last phase >= 0) every
+    # polynomial must start and end inside its window, and the windows must
+    # be tighter than the phases' own (i*min, (i+1)*max) somewhere.
+    durations = PhaseDurations(0, [3.5 / 9] * 9, (0.2, 1.0), optimize=True)
+    rng = np.random.default_rng(3)
+    tighter = False
+    for m in (1, 2, 3):
+        for phase in range(9):
+            for j in range(m):
+                lo, hi = durations.poly_window(phase, j, m)
+                old_hi = 3.5 if phase == 8 else min(1.0 * (phase + 1), 3.5)
+                assert 0.2 * phase - 1e-12 <= lo and hi <= old_hi + 1e-12
+                tighter |= lo > 0.2 * phase + 1e-9 or hi < old_hi - 1e-9
+    assert tighter
+    checked = 0
+    while checked < 300:
+        free = rng.uniform(0.2, 1.0, 8)
+        if rng.random() < 0.3:  # push some schedules onto the extremes
+            free = np.where(rng.random(8) < 0.5, 0.2, 1.0)
+        if free.sum() > 3.5:
+            continue
+        checked += 1
+        d = np.append(free, 3.5 - free.sum())
+        starts = np.concatenate([[0.0], np.cumsum(d)[:-1]])
+        for m in (1, 2, 3):
+            for phase in range(9):
+                for j in range(m):
+                    lo, hi = durations.poly_window(phase, j, m)
+                    start = starts[phase] + j * d[phase] / m
+                    assert lo - 1e-9 <= start and start + d[phase] / m <= hi + 1e-9
 
 
 def test_optimised_durations_give_the_fixed_problem_at_equal_durations(flat: TerrainModel) -> None:

