@@ -253,6 +253,8 @@ def run_job(job: Job) -> dict[str, Any]:
         fell=outcome.fell,
         tick_cpu_ms=_finite(outcome.mean_tick_cpu_ms),
         first_leg_contact=outcome.first_leg_contact,
+        implied_torque=outcome.implied_torque,
+        max_implied_torque_nm=(outcome.implied_torque or {}).get("max_nm"),
         time_s=time.perf_counter() - started,
         cpu_s=time.process_time() - started_cpu,
     )
@@ -299,6 +301,9 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
         ]
         ticks = [r["tick_cpu_ms"] for r in rs if r.get("tick_cpu_ms") is not None]
         pyramid = [r["pyramid_violation_n"] for r in rs if r.get("pyramid_violation_n") is not None]
+        torque = [
+            r["max_implied_torque_nm"] for r in rs if r.get("max_implied_torque_nm") is not None
+        ]
         out.append(
             {
                 "env": env,
@@ -312,6 +317,7 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 "solved_rate": sum(r.get("solve_status") in ("exact", "acceptable") for r in rs)
                 / len(rs),
                 "median_pyramid_violation_n": float(np.median(pyramid)) if pyramid else None,
+                "median_max_implied_torque_nm": float(np.median(torque)) if torque else None,
             }
         )
     return out
@@ -551,8 +557,17 @@ def _progress(row: dict[str, Any]) -> str:
         f"{row.get('solve_status', '-')} in {row.get('iterations', '-')} iterations; "
         f"{'success' if row.get('success') else 'failure'}: {row.get('reason', '')}"
         f"{_leg_contact(row.get('first_leg_contact'))}"
+        f"{_implied_torque(row.get('implied_torque'))}"
         f" ({row.get('cpu_s', 0.0):.0f} s CPU)"
     )
+
+
+def _implied_torque(implied: dict[str, Any] | None) -> str:
+    """'; plan asks 317 N·m of RF_HFE at 4.37 s' for the largest torque the plan's forces imply."""
+    if not implied:
+        return ""
+    where = f"{implied['joint']} at {implied['time_s']:.2f} s"
+    return f"; plan asks {implied['max_nm']:.0f} N·m of {where}"
 
 
 def _leg_contact(touch: dict[str, Any] | None) -> str:

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from roughwalk.robots._rotations import axis_angle_matrix, quat_to_matrix
 from roughwalk.robots.leg_description import LegDescription
 
-__all__ = ["leg_link_frames", "leg_foot_position", "foot_positions"]
+__all__ = ["leg_link_frames", "leg_foot_position", "leg_foot_jacobian", "foot_positions"]
 
 
 def leg_link_frames(
@@ -46,6 +46,22 @@ def leg_foot_position(leg: LegDescription, q: ArrayLike) -> NDArray[np.float64]:
     """Foot centre (3,) in the base frame [m] for the leg's angles q [rad]."""
     positions, rotations = leg_link_frames(leg, q)
     return positions[2] + rotations[2] @ leg.foot
+
+
+def leg_foot_jacobian(leg: LegDescription, q: ArrayLike) -> NDArray[np.float64]:
+    """∂(foot centre)/∂q (3, 3) in the base frame [m/rad]; column k is joint k's.
+
+    A hinge turning about the unit axis a through the point p moves the foot
+    centre x at a × (x − p) per radian.
+    """
+    positions, rotations = leg_link_frames(leg, q)
+    foot = positions[2] + rotations[2] @ leg.foot
+    columns = []
+    for k in range(3):
+        axis = rotations[k] @ leg.axis[k]
+        through = positions[k] + rotations[k] @ leg.anchor[k]
+        columns.append(np.cross(axis, foot - through))
+    return np.array(columns).T
 
 
 def foot_positions(

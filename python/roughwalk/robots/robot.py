@@ -353,6 +353,24 @@ class Robot:
         qc, reachable = core.inverse_kinematics(targets, pos, quat)
         return self.from_canonical(np.asarray(qc)), np.asarray(reachable, dtype=bool)
 
+    def foot_jacobians(
+        self, q: ArrayLike, base_quat: ArrayLike = (1.0, 0.0, 0.0, 0.0)
+    ) -> NDArray[np.float64]:
+        """Per canonical leg, ∂(world foot centre)/∂(its HAA, HFE, KFE) (4, 3, 3) [m/rad].
+
+        ``q`` (12,) [rad] in joint_names order; ``base_quat`` (w, x, y, z)
+        turns the base frame into the world. A force f [N] on leg i's foot
+        asks its joints for −J[i]ᵀ f [N·m] to hold it (leg weight aside).
+        """
+        qc = self.to_canonical(_vector(q, (12,), "q")).reshape(4, 3)
+        rot = quat_to_matrix(_unit_quat(base_quat))
+        return np.array(
+            [
+                rot @ reference_fk.leg_foot_jacobian(leg, a)
+                for leg, a in zip(self._d.legs, qc, strict=True)
+            ]
+        )
+
     def center_of_mass(
         self,
         q: ArrayLike,

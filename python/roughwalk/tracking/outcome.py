@@ -114,6 +114,12 @@ class TrackingOutcome:
         the leg, the time [s] and the foot's planned phase then; None when no
         leg link touched. On the pallets such a touch is often the first
         visible step of a fall.
+    implied_torque:
+        The largest joint torque the plan's own forces ask of the legs
+        (:class:`~roughwalk.trajopt.ImpliedTorques` as a dict: ``max_nm``,
+        ``time_s``, ``joint``, ``limit_nm``, ``over_limit_fraction``,
+        ``unreachable_fraction``); None when not computed (a reference
+        executed without its plan, or a robot without analytic IK).
     log:
         Per-tick arrays (not in :meth:`to_dict`).
     """
@@ -136,6 +142,7 @@ class TrackingOutcome:
     mean_qp_time_ms: float
     mean_tick_cpu_ms: float = 0.0
     first_leg_contact: dict[str, Any] | None = None
+    implied_torque: dict[str, Any] | None = None
     log: TrackingLog | None = field(default=None, repr=False)
     video: str | None = None
 

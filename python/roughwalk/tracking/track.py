@@ -11,7 +11,7 @@ position. An infeasible motion is a reported failure, never an exception.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -83,7 +83,19 @@ def track(
     robot_obj = _named(robot, result.robot, "robot", load_robot)
     terrain_obj = _named(terrain, result.terrain, "terrain", load_terrain)
     reference = Reference.from_result(result)
-    return execute_reference(reference, robot_obj, terrain_obj, config, video=video, push=push)
+    outcome = execute_reference(reference, robot_obj, terrain_obj, config, video=video, push=push)
+    return replace(outcome, implied_torque=_implied_torque(result, robot_obj))
+
+
+def _implied_torque(result: TrajoptResult, robot: Robot) -> dict[str, Any] | None:
+    """The largest joint torque the plan's forces ask (None when the robot has no IK)."""
+    from roughwalk.errors import RobotModelError
+    from roughwalk.trajopt import implied_torques
+
+    try:
+        return implied_torques(result, robot).to_dict()
+    except RobotModelError:
+        return None
 
 
 def _named(value: Any, named: str | None, what: str, loader: Any) -> Any:

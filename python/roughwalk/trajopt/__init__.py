@@ -9,6 +9,7 @@ rate. :class:`TrajoptProblem` builds an NLP once and solves many tasks.
 
 from roughwalk.trajopt.formulation import Formulation
 from roughwalk.trajopt.gaits import GAIT_NAMES, ContactSchedule, make_gait, valid_step_counts
+from roughwalk.trajopt.implied_torques import ImpliedTorques, implied_torques, plan_joint_torques
 from roughwalk.trajopt.initializers import (
     FootstepsInitializer,
     HeuristicInitializer,
@@ -71,4 +72,7 @@ __all__ = [
     "register_initializer",
     "initializer_names",
     "clear_cache",
+    "ImpliedTorques",
+    "implied_torques",
+    "plan_joint_torques",
 ]

@@ -72,7 +72,19 @@ def save_tracking_picture(outcome: TrackingOutcome, path: str | Path, title: str
         ax.axvline(end, color="0.6", lw=0.8, ls=":")
         ax.grid(alpha=0.3)
     verdict = "success" if outcome.success else "failure"
-    fig.suptitle(f"{title + ': ' if title else ''}{verdict} — {outcome.reason}", fontsize=10)
+    headline = f"{title + ': ' if title else ''}{verdict} — {outcome.reason}"
+    implied = outcome.implied_torque
+    if implied is not None:
+        # Where the plan's own forces ask the most of a joint: a dotted line and its figure.
+        limit = implied["limit_nm"]
+        headline += (
+            f"\nthe plan's forces ask up to {implied['max_nm']:.0f} N·m of {implied['joint']}"
+            f"{'' if limit is None else f' (limit {limit:.0f})'} at {implied['time_s']:.2f} s"
+            f" (· · ·); over a limit on {100 * implied['over_limit_fraction']:.0f} % of the plan"
+        )
+        for ax in axes.ravel():
+            ax.axvline(implied["time_s"], color="tab:red", lw=0.8, ls=":")
+    fig.suptitle(headline, fontsize=10)
     fig.tight_layout()
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
