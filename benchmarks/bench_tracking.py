@@ -65,6 +65,8 @@ class Job:
     """TrajoptConfig fields that differ from ``melon_config``'s (``--trajopt``)."""
     add_constraints: tuple[str, ...] = ()
     """Constraints appended to the set (``--add-constraints``), e.g. ``force_between_nodes``."""
+    costs: tuple[tuple[str, float], ...] | None = None
+    """Cost weights that differ from ``melon_config``'s, by dotted name (the learned model's)."""
 
 
 def _task_space(env: str) -> tuple[str, list[Any] | None, str]:
@@ -144,30 +146,24 @@ def learned_model_for(env_terrain: str, optimize_durations: bool, init: str = "l
     return ""
 
 
-def constraints_for(
+def learned_problem(
     env_terrain: str, optimize_durations: bool, init: str = "learned"
-) -> tuple[str, ...] | None:
-    """The constraint set of ``init``'s learned model for this problem (None: the default).
+) -> tuple[tuple[str, ...] | None, tuple[tuple[str, float], ...] | None]:
+    """The constraint set and cost weights of ``init``'s learned model (None: the default).
 
     Every initialiser solves the same NLP on an environment: the one the
     learned model was trained on (the double pallet's adds
-    ``unilateral_between_nodes``), so that the initialisers compare on one
-    problem. ``init`` is "learned" (the shipped model) or "learned:FILE".
+    ``unilateral_between_nodes``; a model trained with
+    ``costs.force_between_nodes_penalty=10`` weighs that term), so that the
+    initialisers compare on one problem. ``init`` is "learned" (the shipped
+    model) or "learned:FILE".
     """
     try:
-        from roughwalk.errors import ConfigError
-        from roughwalk.learning.initializer import model_for_spec
-        from roughwalk.learning.model_constraints import constraints_for_model, spec_for_learned
+        from roughwalk.learning.model_constraints import spec_for_learned
     except ImportError:
-        return None
-    spec = _spec(env_terrain, optimize_durations)
-    if init == "learned":
-        return spec_for_learned(spec).constraints
-    try:
-        model = model_for_spec(init, spec)
-    except ConfigError:
-        return None
-    return constraints_for_model(model, spec.config().constraints)
+        return None, None
+    spec = spec_for_learned(_spec(env_terrain, optimize_durations), init)
+    return spec.constraints, spec.costs
 
 
 def _spec(env_terrain: str, optimize_durations: bool) -> Any:
@@ -183,17 +179,16 @@ def _spec(env_terrain: str, optimize_durations: bool) -> Any:
     )
 
 
-def run_job(job: Job) -> dict[str, Any]:
-    """Solve the job's task and execute the result; a plain dict (picklable)."""
-    from roughwalk.robots import load_robot
-    from roughwalk.terrain import load_terrain
-    from roughwalk.tracking import track
-    from roughwalk.trajopt import Task, melon_config, optimize_motion
+def job_config(job: Job) -> Any:
+    """The TrajoptConfig ``job`` solves: the same for every initialiser on its problem.
 
-    if job.init.partition(":")[0] == "learned":
-        import roughwalk.learning  # noqa: F401
-    robot = load_robot("anymal_c")
-    terrain = load_terrain(job.terrain)
+    The learned model's weights (``job.costs``) are set here rather than left
+    to the learned initialiser, so that the heuristic start solves the same
+    objective; a weight chosen with ``--trajopt`` wins, as it does for the
+    initialiser (:mod:`roughwalk.learning.model_costs`).
+    """
+    from roughwalk.trajopt import melon_config
+
     config = melon_config(
         gait=GAIT, steps=STEPS, duration=DURATION, optimize_durations=job.optimize_durations
     )
@@ -203,6 +198,28 @@ def run_job(job: Job) -> dict[str, Any]:
         config = replace(config, **dict(job.trajopt))
     if job.add_constraints:
         config = replace(config, constraints=config.constraints + job.add_constraints)
+    if job.costs:
+        from roughwalk.config import override
+        from roughwalk.learning.model_costs import cost_changes
+
+        chosen = cost_changes(config.costs)
+        apply = {f"costs.{k}": v for k, v in job.costs if k not in chosen}
+        config = override(config, apply) if apply else config
+    return config
+
+
+def run_job(job: Job) -> dict[str, Any]:
+    """Solve the job's task and execute the result; a plain dict (picklable)."""
+    from roughwalk.robots import load_robot
+    from roughwalk.terrain import load_terrain
+    from roughwalk.tracking import track
+    from roughwalk.trajopt import Task, optimize_motion
+
+    if job.init.partition(":")[0] == "learned":
+        import roughwalk.learning  # noqa: F401
+    robot = load_robot("anymal_c")
+    terrain = load_terrain(job.terrain)
+    config = job_config(job)
     row: dict[str, Any] = {
         "env": job.env,
         "init": job.init,
@@ -484,7 +501,7 @@ def main() -> None:
         for name in inits:
             for opt in durations:
                 learned = learned_init(terrain, opt, args.models)
-                constraints = constraints_for(terrain, opt, learned)
+                constraints, costs = learned_problem(terrain, opt, learned)
                 init = learned if name == "learned" else name
                 why = learned_model_for(terrain, opt, init) if name == "learned" else ""
                 if why:
@@ -507,6 +524,7 @@ def main() -> None:
                                 constraints,
                                 trajopt,
                                 added,
+                                costs,
                             )
                         )
     print(f"{len(jobs)} solve-and-execute jobs ...", flush=True)

@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import roughwalk
 from roughwalk.config import override
@@ -97,3 +98,22 @@ def test_a_spec_s_weights_reach_its_config_and_the_run_record(tmp_path: Path) ->
     assert meta["costs"] == PENALTY
     generate(SPEC, task_space("flat"), 0, tmp_path / "plain", split="test", progress=None)
     assert "costs" not in json.loads((tmp_path / "plain" / "run.json").read_text())
+
+
+def test_init_generate_sets_weights_as_optimize_does_and_names_a_bad_one(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from roughwalk.cli.main import main
+
+    run = tmp_path / "run"
+    argv = ["init", "generate", "--env", "flat", "--steps", "4", "--duration", "2.0"]
+    argv += ["--tasks", "0", "--split", "test", "--out", str(run)]
+    assert main([*argv, "--set", "costs.force_between_nodes_penalty=10"]) == 0
+    meta = json.loads((run / "run.json").read_text())
+    assert meta["costs"] == PENALTY
+    assert meta["problem"]["costs"] == PENALTY
+    capsys.readouterr()
+    assert main([*argv, "--set", "costs.force.wieght=0.1"]) == 1
+    assert "costs.force.wieght=0.1: not a cost weight" in capsys.readouterr().err
+    assert main([*argv, "--set", "costs.force.weight=abc"]) == 1
+    assert "costs.force.weight=abc" in capsys.readouterr().err

@@ -1,8 +1,9 @@
-"""The tracking bench's ``--models DIR``: a candidate model is run and solved with its own set."""
+"""The tracking bench's ``--models DIR``: a candidate model is run and solved with its own NLP."""
 
 from __future__ import annotations
 
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -10,6 +11,7 @@ from _benchmarks import load_benchmark
 
 pytest.importorskip("roughwalk.learning")
 
+from roughwalk.learning import LearnedModel  # noqa: E402
 from roughwalk.learning.initializer import MODELS_DIR  # noqa: E402
 from roughwalk.trajopt.parameters import MELON_REACH_CONSTRAINTS  # noqa: E402
 
@@ -33,8 +35,39 @@ def test_the_folder_s_model_that_fits_the_problem_is_used(candidate: Path) -> No
     init = bench.learned_init("double_pallet", False, candidate)
     assert init == f"learned:{candidate / 'candidate.npz'}"
     assert bench.learned_model_for("double_pallet", False, init) == ""
-    chosen = bench.constraints_for("double_pallet", False, init)
+    chosen, costs = bench.learned_problem("double_pallet", False, init)
     assert chosen == (*MELON_REACH_CONSTRAINTS, "unilateral_between_nodes")
+    assert costs is None  # the shipped model records no weights
+
+
+def test_the_heuristic_start_solves_with_the_model_s_weights_too(tmp_path: Path) -> None:
+    # Both starts must solve one NLP, objective included: a model trained with
+    # a penalty gives it to the heuristic's jobs as well, and --trajopt wins.
+    model = LearnedModel.load(DOUBLE)
+    model.header["costs"] = {"force_between_nodes_penalty": 10.0}
+    model.save(tmp_path / "penalised.npz")
+    bench = load_benchmark("bench_tracking")
+    init = bench.learned_init("double_pallet", False, tmp_path)
+    constraints, costs = bench.learned_problem("double_pallet", False, init)
+    assert costs == (("force_between_nodes_penalty", 10.0),)
+    task = {"max_iter": 0, "optimize_durations": False, "index": 0}
+    task |= {"start": (0.0, 0.0, 0.0), "goal": (1.0, 0.0, 0.0)}
+    jobs = [
+        bench.Job(
+            "double_pallet", "double_pallet", name, **task, constraints=constraints, costs=costs
+        )
+        for name in ("heuristic", init)
+    ]
+    configs = [bench.job_config(job) for job in jobs]
+    assert configs[0] == configs[1]
+    assert configs[0].costs.force_between_nodes_penalty == 10.0
+    trajopt = bench._trajopt_settings("costs.force_between_nodes_penalty=3,costs.swing_height=4")
+    mine = bench.job_config(replace(jobs[0], trajopt=trajopt))
+    assert mine.costs.force_between_nodes_penalty == 3.0
+    assert mine.costs.swing_height == 4.0
+    untouched = bench._trajopt_settings("costs.swing_height=4")
+    kept = bench.job_config(replace(jobs[0], trajopt=untouched))
+    assert kept.costs.force_between_nodes_penalty == 10.0
 
 
 def test_a_folder_without_a_fitting_model_is_reported_not_replaced(candidate: Path) -> None:

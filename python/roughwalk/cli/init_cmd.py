@@ -37,6 +37,14 @@ def _problem_args(p: argparse.ArgumentParser) -> None:
         help="constraint set: melon, melon_reach (the default set) or towr, or "
         "comma-separated constraint names",
     )
+    p.add_argument(
+        "--set",
+        metavar="costs.NAME=VALUE",
+        action="append",
+        default=[],
+        help="a cost weight that differs from melon_config's, as for roughwalk optimize "
+        "(repeatable, dotted names: costs.force_between_nodes_penalty=10, costs.force.weight=0.1)",
+    )
 
 
 def _executor_args(p: argparse.ArgumentParser) -> None:
@@ -136,7 +144,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     """Solve ``--tasks`` sampled tasks into a resumable run folder."""
     from roughwalk.learning.executors import make_executor
     from roughwalk.learning.experience import N_HEURISTIC, generate
-    from roughwalk.learning.problem_spec import ProblemSpec, constraint_set
+    from roughwalk.learning.problem_spec import ProblemSpec, constraint_set, cost_weights
 
     space = _space(args)
     spec = ProblemSpec(
@@ -147,6 +155,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         args.duration,
         args.optimize_durations,
         None if args.constraints is None else constraint_set(args.constraints),
+        cost_weights(args.set),
     )
     out = args.out or DEFAULT_ROOT / f"{space.name}_{args.gait}{args.steps}_{args.split}"
     jitter = _jitter(args.jitter, args.init != "heuristic")

@@ -44,12 +44,13 @@ def constraints_for_model(model: LearnedModel, requested: tuple[str, ...]) -> tu
     return recorded
 
 
-def spec_for_learned(spec: ProblemSpec) -> ProblemSpec:
-    """``spec`` with the constraint set and cost weights of the shipped model that fits it.
+def spec_for_learned(spec: ProblemSpec, init: str = "learned") -> ProblemSpec:
+    """``spec`` with the constraint set and cost weights of ``init``'s model that fits it.
 
-    A spec that names its set keeps it, and the weights it names (see
-    :mod:`.model_costs`); one without a fitting shipped model is returned
-    unchanged (the heuristic then solves the default NLP).
+    ``init`` is "learned" (the shipped model) or "learned:FILE". A spec that
+    names its set keeps it, and the weights it names (see
+    :mod:`.model_costs`); one without a fitting model is returned unchanged
+    (the heuristic then solves the default NLP).
     """
     from dataclasses import replace
 
@@ -58,7 +59,7 @@ def spec_for_learned(spec: ProblemSpec) -> ProblemSpec:
     from roughwalk.learning.model_costs import cost_changes, costs_for_model
 
     try:
-        model = model_for_spec("learned", spec)
+        model = model_for_spec(init, spec)
     except ConfigError:
         return spec
     config = spec.config()

@@ -31,10 +31,10 @@ from roughwalk.trajopt.parameters import CostWeights, melon_config
 if TYPE_CHECKING:
     from roughwalk.learning.model_file import LearnedModel
 
-__all__ = ["cost_changes", "recorded_costs", "costs_for_model"]
+__all__ = ["cost_leaves", "cost_changes", "recorded_costs", "costs_for_model"]
 
 
-def _leaves(costs: CostWeights) -> dict[str, Any]:
+def cost_leaves(costs: CostWeights) -> dict[str, Any]:
     """Every weight of ``costs`` by dotted name ("force.weight", "step_edge")."""
     out: dict[str, Any] = {}
     for key, value in to_dict(costs).items():
@@ -47,8 +47,8 @@ def _leaves(costs: CostWeights) -> dict[str, Any]:
 
 def cost_changes(costs: CostWeights) -> dict[str, float]:
     """The weights of ``costs`` that differ from the default configuration's, by dotted name."""
-    default = _leaves(melon_config().costs)
-    return {k: float(v) for k, v in _leaves(costs).items() if v != default.get(k)}
+    default = cost_leaves(melon_config().costs)
+    return {k: float(v) for k, v in cost_leaves(costs).items() if v != default.get(k)}
 
 
 def recorded_costs(model: LearnedModel) -> dict[str, float] | None:

@@ -9,13 +9,14 @@ process (:func:`build_problem` caches it) and describes its variable layout.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from roughwalk.config import override
+from roughwalk.config import override, parse_set
 from roughwalk.errors import ConfigError
 from roughwalk.trajopt import (
     Formulation,
@@ -36,6 +37,7 @@ __all__ = [
     "ProblemSpec",
     "CONSTRAINT_SETS",
     "constraint_set",
+    "cost_weights",
     "build_problem",
     "variable_layout",
     "variable_categories",
@@ -155,6 +157,35 @@ def constraint_set(text: str) -> tuple[str, ...]:
             f"{', '.join(CONSTRAINT_SETS)} or names among {', '.join(sorted(known))}"
         )
     return names
+
+
+def cost_weights(items: Iterable[str]) -> tuple[tuple[str, float], ...] | None:
+    """``costs.NAME=VALUE`` items (``roughwalk init generate --set``) as :attr:`ProblemSpec.costs`.
+
+    Spelled and parsed as ``roughwalk optimize --set`` (:func:`~roughwalk.config.parse_set`,
+    dotted names such as ``costs.force.weight``); each weight is checked
+    against :func:`~roughwalk.trajopt.melon_config`'s, and a bad name or value
+    raises :class:`~roughwalk.errors.ConfigError` naming the item. Only the
+    weights that differ from the defaults are kept (None: none), as the run
+    records them, so that an explicit default value makes the same problem.
+    """
+    from roughwalk.learning.model_costs import cost_changes, cost_leaves
+
+    weights = melon_config().costs
+    known = cost_leaves(weights)
+    for key, value in parse_set(items).items():
+        name = key.removeprefix("costs.")
+        if name == key or name not in known:
+            raise ConfigError(
+                f"--set {key}={value}: not a cost weight; give costs.NAME=VALUE with NAME "
+                f"among {', '.join(known)}"
+            )
+        try:
+            weights = override(weights, {name: value})
+        except ConfigError as e:
+            raise ConfigError(f"--set {key}={value}: {e}") from None
+    changes = cost_changes(weights)
+    return tuple(sorted(changes.items())) if changes else None
 
 
 def build_problem(spec: ProblemSpec) -> TrajoptProblem:
