@@ -363,7 +363,12 @@ class ReflexConfig:
         LF's swing, is rescued now; 3.0 s still falls) and 8 of 9 to the
         right (the same: 2.2 s, LF's lift-off, falls with both; see
         ``TimingConfig`` in :mod:`roughwalk.trajectories.config` for why no
-        trigger mends that one).
+        trigger mends that one). The repeatable bench (``roughwalk bench
+        littledog --classes barrier,steps,round_rocks,sloped_rocks,gap,logs,large_rocks
+        --expansions 40000 --seeds 2 --set executor.compute_time_scale=0
+        --set reflex.replan_budget_s=300``) walks every run as at 0.05, to
+        the millisecond and reflex (none fires sooner or more often there),
+        and the demo course stays at 5.64 cm/s.
     persist_s:
         An error must last this long [s] to count, so impact transients do not.
     settle_s:
