@@ -165,6 +165,38 @@ def test_one_reflex_rescues_a_push_to_the_right_mid_stride(
     assert_walked_to_goal(result)
 
 
+FAST_SWINGS = {"swing.time_law": "joint", "timing.min_swing_s": 0.2}
+"""The faster swings measured in session 10 (not the default): LF's swing spans 2.0 s."""
+
+
+def test_an_early_reflex_catches_a_push_towards_a_swinging_front_foot(littledog) -> None:
+    # Pushed left 0.09 s into LF's swing, the trunk rolls over the RF–LH
+    # diagonal and RH lets go 0.02 s later. With the foot-force reflex
+    # gated at 0.05 rad of trunk tilt it fired 0.11 s after the push, the
+    # trunk moving sideways at 0.22 m/s, and the robot rolled over on
+    # its lowered left feet; gated at 0.03 rad one reflex rescues it (the
+    # trunk still rolls 18°, past assert_walked_to_goal's 0.3 rad).
+    terrain = roughwalk.load_terrain("flat")
+    push = Push(impulse_ns=1.0, at_s=2.0, direction_deg=90.0)
+    config = roughwalk.trajectories.trajectory_config(**FAST_SWINGS)
+    result = walk(littledog, terrain, disturbances=[push], trajectory_config=config)
+    assert result.outcome.reflexes == 1 and result.outcome.replans == 1
+    assert [e["detail"] for e in result.log.events if e["kind"] == "reflex"][0].startswith(
+        "foot_force (RH)"
+    )
+    o = result.outcome
+    assert o.success and not o.fell and o.reason == "reached the goal", o.reason
+    assert o.distance_m == pytest.approx(0.5, abs=0.02) and o.max_roll_rad < 0.4
+    late = walk(
+        littledog,
+        terrain,
+        disturbances=[push],
+        trajectory_config=config,
+        overrides={"reflex.foot_force_tilt_rad": 0.05},
+    )
+    assert late.outcome.fell
+
+
 class StopsInsideGoalRadius:
     """Plans as :func:`source`, but a re-plan from feet within ``radius`` [m] of the goal
     returns the stance alone: what the planner returns from inside its goal radius."""

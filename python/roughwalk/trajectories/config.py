@@ -254,13 +254,24 @@ class TimingConfig:
     large rocks 1/2 at 3.23 → 2/2 at 3.21 (the seed both reach 3.23 →
     3.41): every run the old defaults win still wins.
     The fast timing's swing part on top (``swing.time_law`` "joint",
-    ``min_swing_s`` 0.2; demo 6.00 cm/s, barrier 5.29, steps 5.51, round
-    rocks 4.17) is not the default: with both, the robot falls under the
-    1 N·s left push at 2.0 s that each part alone survives. The 1 N·s side
-    push from 1.6 to 3.2 s (``roughwalk bench push_recovery --from 1.6
-    --to 3.2``, 0.2 s apart) to the right survives 7 → 8 of 9 (the old
-    defaults fall at 2.2 and 2.4 s, these at 2.2 s), to the left 8 → 7 of
-    9 (the old at 3.2 s, these at 2.2 and 3.0 s).
+    ``min_swing_s`` 0.2) is an option, not the default. The robot fell
+    under the 1 N·s left push at 2.0 s that each part alone survives: the
+    push lands 0.09 s into LF's swing, the CoM 1.5 cm inside the RF–LH
+    diagonal, RH lets go 0.02 s later and the trunk rolls over that
+    diagonal; the foot-force reflex, gated at 0.05 rad of tilt, fired
+    0.11 s after the push (0.22 m/s sideways, 5° of roll), too late for
+    the lowered LF. Since ``reflex.foot_force_tilt_rad`` 0.03 one reflex
+    rescues it. With that, against the defaults (same commands as above,
+    the defaults' figures just above): demo 5.64 → 6.00 cm/s (swings
+    0.34 → 0.30 s); barrier 2/2 at 4.73 → 5.29, steps 2/2 at 4.95 → 5.51,
+    round rocks 2/2 at 4.34 → 4.17, sloped rocks 1/2 at 5.90 → 3.91 (seed
+    0, 2 reflexes; seed 1 falls at 1.8 s instead of failing its re-plan),
+    gap 2/2 at 4.89 → 5.59, logs 2/2 at 4.80 → 4.84, large rocks 2/2 at
+    3.21 → 1/2 at 2.48 (seed 0's re-plan fails after 3 reflexes): a run
+    lost. The side push from 1.6 to 3.2 s: to the left 9 of 9 (8 with the
+    defaults), to the right 7 (8): 1.8 and 2.0 s fall, the push just before
+    or after LF lifts, as the defaults' 2.2 s; the trunk rolls over the
+    RF–RH edge onto the right feet (see ``min_shift_s`` on that phase).
     """
 
     velocity_margin: float = 1.3
