@@ -57,12 +57,12 @@ class Job:
     index: int
     start: tuple[float, float, float]
     goal: tuple[float, float, float]
-    tracking: tuple[tuple[str, Any], ...] = ()
-    """TrackingConfig fields that differ from the default (``--tracking``)."""
+    tracking: tuple[tuple[str, str], ...] = ()
+    """TrackingConfig fields that differ from the default, dotted key → value (``--tracking``)."""
     constraints: tuple[str, ...] | None = None
     """The NLP's constraint set (None: ``melon_config``'s default)."""
-    trajopt: tuple[tuple[str, Any], ...] = ()
-    """TrajoptConfig fields that differ from ``melon_config``'s (``--trajopt``)."""
+    trajopt: tuple[tuple[str, str], ...] = ()
+    """TrajoptConfig fields unlike ``melon_config``'s, dotted key → value (``--trajopt``)."""
     add_constraints: tuple[str, ...] = ()
     """Constraints appended to the set (``--add-constraints``), e.g. ``force_between_nodes``."""
     costs: tuple[tuple[str, float], ...] | None = None
@@ -187,6 +187,7 @@ def job_config(job: Job) -> Any:
     objective; a weight chosen with ``--trajopt`` wins, as it does for the
     initialiser (:mod:`roughwalk.learning.model_costs`).
     """
+    from roughwalk.config import override
     from roughwalk.trajopt import melon_config
 
     config = melon_config(
@@ -195,17 +196,24 @@ def job_config(job: Job) -> Any:
     if job.constraints is not None:
         config = replace(config, constraints=job.constraints)
     if job.trajopt:
-        config = replace(config, **dict(job.trajopt))
+        config = override(config, dict(job.trajopt))
     if job.add_constraints:
         config = replace(config, constraints=config.constraints + job.add_constraints)
     if job.costs:
-        from roughwalk.config import override
         from roughwalk.learning.model_costs import cost_changes
 
         chosen = cost_changes(config.costs)
         apply = {f"costs.{k}": v for k, v in job.costs if k not in chosen}
         config = override(config, apply) if apply else config
     return config
+
+
+def job_tracking(job: Job) -> Any:
+    """The TrackingConfig ``job`` executes with: the default and its ``--tracking`` settings."""
+    from roughwalk.config import override
+    from roughwalk.tracking import TrackingConfig
+
+    return override(TrackingConfig(), dict(job.tracking))
 
 
 def run_job(job: Job) -> dict[str, Any]:
@@ -253,9 +261,7 @@ def run_job(job: Job) -> dict[str, Any]:
         return row
     row.update(pyramid_violation_n=pyramid_violation(result))
     try:
-        from roughwalk.tracking import TrackingConfig
-
-        outcome = track(result, robot, terrain, TrackingConfig(**dict(job.tracking)))
+        outcome = track(result, robot, terrain, job_tracking(job))
     except Exception as e:  # noqa: BLE001
         row.update(success=False, reason=f"execution raised {type(e).__name__}: {e}")
         return row
@@ -392,47 +398,47 @@ def figure4(out_dir: Path) -> list[dict[str, Any]]:
     return rows
 
 
-def _tracking_settings(text: str) -> tuple[tuple[str, Any], ...]:
-    """``NAME=VALUE,...`` as TrackingConfig fields (true/false, numbers), checked by name."""
+def _tracking_settings(*texts: str) -> tuple[tuple[str, str], ...]:
+    """``--tracking`` values as dotted TrackingConfig keys → value strings, checked by name."""
     from roughwalk.tracking import TrackingConfig
 
-    return _settings(text, TrackingConfig, "--tracking")
+    return _settings(texts, TrackingConfig(), "--tracking")
 
 
-def _trajopt_settings(text: str) -> tuple[tuple[str, Any], ...]:
-    """``NAME=VALUE,...`` as TrajoptConfig fields (true/false, numbers), checked by name."""
-    from roughwalk.trajopt import TrajoptConfig, melon_config
+def _trajopt_settings(*texts: str) -> tuple[tuple[str, str], ...]:
+    """``--trajopt`` values as dotted TrajoptConfig keys → value strings, checked by name."""
+    from roughwalk.trajopt import melon_config
 
-    return _settings(text, TrajoptConfig, "--trajopt", melon_config())
+    return _settings(texts, melon_config(), "--trajopt")
 
 
-def _settings(
-    text: str, cls: type, option: str, defaults: Any = None
-) -> tuple[tuple[str, Any], ...]:
-    """``NAME=VALUE,...`` as fields of the dataclass ``cls`` (true/false, numbers).
+def _settings(texts: tuple[str, ...], base: Any, option: str) -> tuple[tuple[str, str], ...]:
+    """``NAME=VALUE,...`` (one or more flags, later wins) as the project's ``--set`` overrides.
 
-    A dotted ``NAME.FIELD`` changes one field of a nested config, starting
-    from ``defaults``' (or ``cls()``'s) value of it.
+    Names are dotted keys of any depth (``costs.force.weight=0.1``), read
+    by :func:`roughwalk.config.parse_set`; a piece without ``=`` continues
+    the previous value, so lists keep their commas
+    (``constraints=dynamics,range_of_motion``). The keys and values are
+    checked by applying them to ``base`` with :func:`roughwalk.config.override`
+    (which names a bad key and lists the valid ones) and kept as strings,
+    so that a Job stays plain data; :func:`job_config` applies them.
     """
-    import dataclasses
+    from roughwalk.config import override, parse_set
+    from roughwalk.errors import ConfigError
 
-    names = {f.name for f in dataclasses.fields(cls)}
-    out: dict[str, Any] = {}
-    for item in filter(None, (v.strip() for v in text.split(","))):
-        name, _, value = item.partition("=")
-        # A dotted name sets a field of a nested config: costs.force_between_nodes_penalty=10.
-        head, _, rest = name.partition(".")
-        if head not in names:
-            raise SystemExit(f"{option}: {cls.__name__} has no field {head!r}")
-        low = value.lower()
-        parsed: Any = low == "true" if low in ("true", "false") else float(value)
-        if rest:
-            nested = out.get(head, getattr(defaults or cls(), head))
-            if rest not in {f.name for f in dataclasses.fields(nested)}:
-                raise SystemExit(f"{option}: {type(nested).__name__} has no field {rest!r}")
-            parsed = dataclasses.replace(nested, **{rest: parsed})
-        out[head] = parsed
-    return tuple(out.items())
+    items: list[str] = []
+    for text in texts:
+        for piece in filter(None, (v.strip() for v in text.split(","))):
+            if "=" in piece or not items:
+                items.append(piece)
+            else:
+                items[-1] += "," + piece
+    try:
+        changes = parse_set(items)
+        override(base, changes)
+    except ConfigError as e:
+        raise SystemExit(f"{option}: {e}") from None
+    return tuple(changes.items())
 
 
 def main() -> None:
@@ -455,13 +461,17 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0, help="task sampling seed")
     parser.add_argument(
         "--tracking",
-        default="",
-        help="controller settings that differ from the default, e.g. track_com=true",
+        action="append",
+        default=[],
+        help="controller settings that differ from the default, NAME=VALUE[,...], "
+        "repeatable, dotted names reach nested configs, e.g. track_com=true",
     )
     parser.add_argument(
         "--trajopt",
-        default="",
-        help="NLP settings that differ from melon_config's, e.g. dt_dynamics=0.05",
+        action="append",
+        default=[],
+        help="NLP settings that differ from melon_config's, NAME=VALUE[,...], repeatable, "
+        "dotted names reach nested configs, e.g. dt_dynamics=0.05,costs.force.weight=0.1",
     )
     parser.add_argument(
         "--add-constraints",
@@ -478,8 +488,8 @@ def main() -> None:
 
     n = 100 if args.full else args.tasks
     iters = [int(v) for v in args.iters.split(",") if v]
-    tracking = _tracking_settings(args.tracking)
-    trajopt = _trajopt_settings(args.trajopt)
+    tracking = _tracking_settings(*args.tracking)
+    trajopt = _trajopt_settings(*args.trajopt)
     inits = [v for v in args.init.split(",") if v]
     notes = [f"tracking settings: {dict(tracking)}"] if tracking else []
     notes += [f"NLP settings: {dict(trajopt)}"] if trajopt else []

@@ -70,6 +70,22 @@ def test_the_heuristic_start_solves_with_the_model_s_weights_too(tmp_path: Path)
     assert kept.costs.force_between_nodes_penalty == 10.0
 
 
+def test_a_two_level_trajopt_weight_wins_over_the_model_s_recorded_one(tmp_path: Path) -> None:
+    model = LearnedModel.load(DOUBLE)
+    model.header["costs"] = {"force.weight": 0.2}
+    model.save(tmp_path / "force_weighted.npz")
+    bench = load_benchmark("bench_tracking")
+    init = bench.learned_init("double_pallet", False, tmp_path)
+    constraints, costs = bench.learned_problem("double_pallet", False, init)
+    job = bench.Job(
+        "double_pallet", "double_pallet", "heuristic", 0, False, 0, (0.0, 0.0, 0.0),
+        (1.0, 0.0, 0.0), constraints=constraints, costs=costs,
+    )  # fmt: skip
+    assert bench.job_config(job).costs.force.weight == 0.2
+    trajopt = bench._trajopt_settings("costs.force.weight=0.3")
+    assert bench.job_config(replace(job, trajopt=trajopt)).costs.force.weight == 0.3
+
+
 def test_a_folder_without_a_fitting_model_is_reported_not_replaced(candidate: Path) -> None:
     bench = load_benchmark("bench_tracking")
     init = bench.learned_init("single_pallet", False, candidate)
