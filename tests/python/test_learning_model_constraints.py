@@ -4,41 +4,18 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
+from _learned_models import SPEC, heuristic_guess_model
 
 import roughwalk
-from roughwalk.learning import LearnedModel, ProblemSpec, build_problem
-from roughwalk.learning.mlp import MLP
+from roughwalk.learning import LearnedModel, ProblemSpec
 from roughwalk.learning.model_constraints import constraints_for_model, spec_for_learned
-from roughwalk.learning.model_file import MODEL_FORMAT, problem_signature
-from roughwalk.trajopt import HeuristicInitializer, Task
 from roughwalk.trajopt.parameters import MELON_REACH_CONSTRAINTS, TOWR_CONSTRAINTS
-from roughwalk.trajopt.task import resolve
 
-SPEC = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0)
 WITH_FORCES = (*MELON_REACH_CONSTRAINTS, "force_between_nodes")
 
 
 def _model(constraints: tuple[str, ...] | None) -> LearnedModel:
-    """A model whose every prediction is the heuristic's guess of one task (a sane start)."""
-    problem = build_problem(SPEC)
-    nlp = problem.formulation
-    n_out = nlp.n_variables
-    guess = HeuristicInitializer().guess(
-        nlp, resolve(Task((0, 0, 0), (0.4, 0, 0)), problem.body, problem.terrain)
-    )
-    weights = (np.zeros((6, 5), np.float32), np.zeros((5, n_out), np.float32))
-    biases = (np.zeros(5, np.float32), np.zeros(n_out, np.float32))
-    mlp = MLP(weights, biases, "tanh", np.zeros(6), np.ones(6), guess, np.ones(n_out))
-    header: dict[str, object] = {
-        "format": MODEL_FORMAT,
-        "version": 1,
-        "problem": SPEC.to_dict(),
-        "layout": problem_signature(nlp)["layout"],
-    }
-    if constraints is not None:
-        header["constraints"] = list(constraints)
-    return LearnedModel(mlp, header)
+    return heuristic_guess_model(constraints=None if constraints is None else list(constraints))
 
 
 def test_the_model_s_recorded_set_replaces_the_default_but_not_a_chosen_one() -> None:

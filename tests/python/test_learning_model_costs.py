@@ -5,44 +5,21 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import numpy as np
 import pytest
+from _learned_models import SPEC, heuristic_guess_model
 
 import roughwalk
 from roughwalk.config import override
-from roughwalk.learning import LearnedModel, ProblemSpec, build_problem, task_space
+from roughwalk.learning import LearnedModel, ProblemSpec, task_space
 from roughwalk.learning.experience import generate
-from roughwalk.learning.mlp import MLP
 from roughwalk.learning.model_costs import cost_changes, costs_for_model, recorded_costs
-from roughwalk.learning.model_file import MODEL_FORMAT, problem_signature
-from roughwalk.trajopt import HeuristicInitializer, Task
 from roughwalk.trajopt.parameters import melon_config
-from roughwalk.trajopt.task import resolve
 
-SPEC = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0)
 PENALTY = {"force_between_nodes_penalty": 10.0}
 
 
 def _model(costs: dict[str, float] | None) -> LearnedModel:
-    """A model whose every prediction is the heuristic's guess of one task (a sane start)."""
-    problem = build_problem(SPEC)
-    nlp = problem.formulation
-    n_out = nlp.n_variables
-    guess = HeuristicInitializer().guess(
-        nlp, resolve(Task((0, 0, 0), (0.4, 0, 0)), problem.body, problem.terrain)
-    )
-    weights = (np.zeros((6, 5), np.float32), np.zeros((5, n_out), np.float32))
-    biases = (np.zeros(5, np.float32), np.zeros(n_out, np.float32))
-    mlp = MLP(weights, biases, "tanh", np.zeros(6), np.ones(6), guess, np.ones(n_out))
-    header: dict[str, object] = {
-        "format": MODEL_FORMAT,
-        "version": 1,
-        "problem": SPEC.to_dict(),
-        "layout": problem_signature(nlp)["layout"],
-    }
-    if costs is not None:
-        header["costs"] = costs
-    return LearnedModel(mlp, header)
+    return heuristic_guess_model(costs=None if costs is None else costs)
 
 
 def test_recorded_weights_survive_a_save_and_load(tmp_path: Path) -> None:
