@@ -19,7 +19,13 @@ from roughwalk.trajopt import (
     valid_step_counts,
 )
 from roughwalk.trajopt.task import Task, resolve
-from roughwalk.trajopt.variables import NodeSpline, NumericSpline, PhaseDurations, hermite_point
+from roughwalk.trajopt.variables import (
+    NodeSpline,
+    NumericSpline,
+    PhaseDurations,
+    hermite_point,
+    sample_points,
+)
 
 
 @pytest.fixture(scope="module")
@@ -165,6 +171,30 @@ def test_symbolic_durations_pick_the_right_polynomial() -> None:
         np.testing.assert_allclose(values[0:3, ok].T, p[ok], atol=1e-10)
         np.testing.assert_allclose(values[3:6, ok].T, v[ok], atol=1e-10)
         np.testing.assert_allclose(values[6:9, ok].T, a[ok], atol=1e-9)
+
+
+def test_mapped_spline_points_equal_the_single_ones() -> None:
+    # Fixed durations: one mapped call must give the point-by-point values
+    # bit for bit, junctions and the end included.
+    x = ca.SX.sym("x", 3, 5)
+    v = ca.SX.sym("v", 3, 5)
+    durations = [0.3, 0.2, 0.5, 0.25]
+    spline = NodeSpline(ca.horzsplit(x), ca.horzsplit(v), durations)
+    times = [0.0, 0.1, 0.3, 0.45, 0.5, 0.9, 1.25]
+    (mapped,) = sample_points([spline], times)
+    single = [spline.point(t) for t in times]
+    f = ca.Function(
+        "f",
+        [x, v],
+        [
+            ca.horzcat(*[ca.vertcat(*p) for p in mapped]),
+            ca.horzcat(*[ca.vertcat(*p) for p in single]),
+        ],
+    )
+    rng = np.random.default_rng(2)
+    a, b = f(rng.normal(size=(3, 5)), rng.normal(size=(3, 5)))
+    assert np.array_equal(np.asarray(a), np.asarray(b))
+    assert not np.all(np.asarray(a) == 0)
 
 
 def test_polynomial_windows_hold_every_admissible_schedule() -> None:

@@ -25,7 +25,16 @@ class BaseAccelerationContinuity(Constraint):
         parts = []
         for variables in (nlp.base_lin, nlp.base_ang):
             spline = variables.spline
-            for k in range(spline.n_polys - 1):
+            n = spline.n_polys - 1
+            if spline.fixed:
+                ends = spline.poly_points(range(n), spline.durations[:n])
+                starts = spline.poly_points(range(1, n + 1), [0.0] * n)
+                for end, start in zip(ends, starts, strict=True):
+                    parts.append((end[2] - start[2], 0.0, 0.0))
+                continue
+            # Symbolic durations: the expressions in the order they were
+            # always made (see sample_points: that order steers IPOPT).
+            for k in range(n):
                 before = spline.poly_point(k, spline.durations[k])[2]
                 after = spline.poly_point(k + 1, 0.0)[2]
                 parts.append((before - after, 0.0, 0.0))

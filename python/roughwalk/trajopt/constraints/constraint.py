@@ -91,8 +91,25 @@ class Constraint(ABC):
 def stack_calls(
     name: str, function: ca.Function, calls: Sequence[tuple[Sequence[ca.SX], Bound, Bound]]
 ) -> Rows | None:
-    """Rows ``function(*inputs)`` from (inputs, lower, upper) pieces, keeping the calls."""
-    rows = stack_rows(name, [(function(*inputs), lo, hi) for inputs, lo, hi in calls])
-    if rows is not None:
-        rows.calls = [Call(function, tuple(map(_as_sx, inputs))) for inputs, _, _ in calls]
-    return rows
+    """Rows ``function(*inputs)`` from (inputs, lower, upper) pieces, keeping the calls.
+
+    A column-valued function is called once, mapped over the pieces: the
+    same expressions as calling it piece by piece, in less CPU.
+    """
+    if not calls or function.n_out() != 1 or function.size2_out(0) != 1:
+        rows = stack_rows(name, [(function(*inputs), lo, hi) for inputs, lo, hi in calls])
+        if rows is not None:
+            rows.calls = [Call(function, tuple(map(_as_sx, inputs))) for inputs, _, _ in calls]
+        return rows
+    inputs = [tuple(map(_as_sx, args)) for args, _, _ in calls]
+    mapped = function.map(len(calls))(
+        *[ca.horzcat(*[args[i] for args in inputs]) for i in range(function.n_in())]
+    )
+    n = function.size1_out(0)
+    lower = np.concatenate(
+        [np.broadcast_to(np.asarray(lo, dtype=float), (n,)) for _, lo, _ in calls]
+    )
+    upper = np.concatenate(
+        [np.broadcast_to(np.asarray(hi, dtype=float), (n,)) for _, _, hi in calls]
+    )
+    return Rows(name, ca.vec(mapped), lower, upper, [Call(function, args) for args in inputs])

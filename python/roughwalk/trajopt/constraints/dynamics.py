@@ -16,7 +16,12 @@ import casadi as ca
 
 from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_calls
 from roughwalk.trajopt.robot_model import GRAVITY, SingleRigidBody
-from roughwalk.trajopt.variables import angular_acceleration, angular_velocity, euler_to_rotation
+from roughwalk.trajopt.variables import (
+    angular_acceleration,
+    angular_velocity,
+    euler_to_rotation,
+    sample_points,
+)
 
 if TYPE_CHECKING:
     from roughwalk.trajopt.formulation import Formulation
@@ -54,11 +59,17 @@ class Dynamics(Constraint):
     def build(self, nlp: Formulation) -> Rows | None:
         """Six rows per sample time."""
         residual = dynamics_residual_function(nlp.body, nlp.n_feet)
+        times = nlp.sample_times(nlp.config.dt_dynamics)
+        n = nlp.n_feet
+        splines = [nlp.base_lin.spline, nlp.base_ang.spline]
+        splines += [m.spline for m in nlp.feet] + [f.spline for f in nlp.forces]
+        base_lin, base_ang, *ends = sample_points(splines, times)
+        feet, forces = ends[:n], ends[n:]
         parts = []
-        for t in nlp.sample_times(nlp.config.dt_dynamics):
-            c, _, cdd = nlp.base_lin.spline.point(t)
-            eta, etad, etadd = nlp.base_ang.spline.point(t)
-            feet = ca.vertcat(*[m.spline.point(t)[0] for m in nlp.feet])
-            forces = ca.vertcat(*[f.spline.point(t)[0] for f in nlp.forces])
-            parts.append(((c, cdd, eta, etad, etadd, feet, forces), 0.0, 0.0))
+        for j in range(len(times)):
+            c, _, cdd = base_lin[j]
+            eta, etad, etadd = base_ang[j]
+            foot_points = ca.vertcat(*[points[j][0] for points in feet])
+            force_points = ca.vertcat(*[points[j][0] for points in forces])
+            parts.append(((c, cdd, eta, etad, etadd, foot_points, force_points), 0.0, 0.0))
         return stack_calls(self.name, residual, parts)

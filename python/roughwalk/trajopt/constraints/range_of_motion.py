@@ -11,7 +11,7 @@ import casadi as ca
 import numpy as np
 
 from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_calls
-from roughwalk.trajopt.variables import euler_to_rotation
+from roughwalk.trajopt.variables import euler_to_rotation, sample_points
 
 if TYPE_CHECKING:
     from roughwalk.trajopt.formulation import Formulation
@@ -31,12 +31,13 @@ class RangeOfMotion(Constraint):
         )
         stance = nlp.body.stance
         dev = np.asarray(nlp.body.max_deviation)
+        times = nlp.sample_times(nlp.config.dt_range_of_motion)
+        splines = [nlp.base_lin.spline, nlp.base_ang.spline] + [m.spline for m in nlp.feet]
+        base, angles, *feet = sample_points(splines, times)
         parts = []
-        for t in nlp.sample_times(nlp.config.dt_range_of_motion):
-            base = nlp.base_lin.spline.point(t)[0]
-            angles = nlp.base_ang.spline.point(t)[0]
-            for i, motion in enumerate(nlp.feet):
+        for j in range(len(times)):
+            for i, points in enumerate(feet):
                 parts.append(
-                    ((base, angles, motion.spline.point(t)[0]), stance[i] - dev, stance[i] + dev)
+                    ((base[j][0], angles[j][0], points[j][0]), stance[i] - dev, stance[i] + dev)
                 )
         return stack_calls(self.name, in_base, parts)

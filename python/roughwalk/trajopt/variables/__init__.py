@@ -23,7 +23,7 @@ from roughwalk.trajopt.variables.hermite import (
     polynomial_value,
 )
 from roughwalk.trajopt.variables.phase_durations import PhaseDurations
-from roughwalk.trajopt.variables.spline import NodeSpline, NumericSpline
+from roughwalk.trajopt.variables.spline import NodeSpline, NumericSpline, sample_points
 from roughwalk.trajopt.variables.variable_set import NodeIndex, NodeVariableSet, VariableSet
 
 __all__ = [
@@ -37,6 +37,7 @@ __all__ = [
     "PhaseDurations",
     "NodeSpline",
     "NumericSpline",
+    "sample_points",
     "base_poly_durations",
     "hermite_coefficients",
     "hermite_point",

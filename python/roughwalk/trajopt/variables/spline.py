@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from roughwalk.trajopt.variables.hermite import hermite_point
 
-__all__ = ["NodeSpline", "NumericSpline"]
+__all__ = ["NodeSpline", "NumericSpline", "sample_points"]
 
 _EPS = 1e-9  # [s] tolerance of time comparisons against numeric junctions
 
@@ -125,6 +125,34 @@ class NodeSpline:
         )
         return out[0], out[1], out[2]
 
+    def poly_points(
+        self, ks: Sequence[int], ss: Sequence[float]
+    ) -> list[tuple[ca.SX, ca.SX, ca.SX]]:
+        """:meth:`poly_point` of polynomials ``ks`` at numeric local times ``ss``, in one call.
+
+        The same expressions as calling it point by point, from one mapped
+        call: on the flat trot a third of the CPU of its 766 calls.
+        """
+        if not ks:
+            return []
+        n = len(ks)
+        out = _hermite_function(int(self.positions[0].numel())).map(n)(
+            ca.horzcat(*[self.positions[k] for k in ks]),
+            ca.horzcat(*[self.velocities[k] for k in ks]),
+            ca.horzcat(*[self.positions[k + 1] for k in ks]),
+            ca.horzcat(*[self.velocities[k + 1] for k in ks]),
+            ca.DM([[float(self.durations[k]) for k in ks]]),
+            ca.DM([list(map(float, ss))]),
+        )
+        return list(zip(*(ca.horzsplit(o) for o in out), strict=True))
+
+    def points(self, times: Sequence[float]) -> list[tuple[ca.SX, ca.SX, ca.SX]]:
+        """:meth:`point` at every time of ``times`` [s]; one mapped call if durations are fixed."""
+        if not self.fixed:
+            return [self.point(t) for t in times]
+        ks = [self.poly_at(t) for t in times]
+        return self.poly_points(ks, [t - self.starts[k] for t, k in zip(times, ks, strict=True)])
+
     def poly_at(self, t: float) -> int:
         """Index of the polynomial holding time t [s]; a junction belongs to the earlier one."""
         if not self.fixed:
@@ -164,6 +192,24 @@ class NodeSpline:
             ca.horzcat(*[self.velocities[k + 1] for k in ks]),
         )
         return out[0], out[1], out[2]
+
+
+def sample_points(
+    splines: Sequence[NodeSpline], times: Sequence[float]
+) -> list[list[tuple[ca.SX, ca.SX, ca.SX]]]:
+    """Position, velocity, acceleration of every spline (outer list) at every time (inner).
+
+    With fixed durations every spline's points come from one mapped call
+    (:meth:`NodeSpline.points`). Otherwise they are made time by time, spline
+    by spline, in the order the constraints always made them: with
+    optimised durations that order steers IPOPT (the pallet climb took 89
+    iterations one way, 63 and 69 in others, though f, g and their
+    derivatives were equal at every point tried).
+    """
+    if all(s.fixed for s in splines):
+        return [s.points(times) for s in splines]
+    by_time = [[s.point(t) for s in splines] for t in times]
+    return [[row[i] for row in by_time] for i in range(len(splines))]
 
 
 class NumericSpline:
