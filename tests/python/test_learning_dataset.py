@@ -73,6 +73,10 @@ def test_dataset_round_trips_through_npz_and_json(tmp_path: Path) -> None:
         data.select(data["index"] < 2).append(other.select(other["index"] >= 2))
     joined = data.select(data["index"] < 2).append(back.select(back["index"] >= 2))
     assert joined.same_rows(data, ignore=())
+    # A changed value is named by its column; timings are ignored by default.
+    changed = {**back.columns, "cost": back["cost"] + 1e-12, "solve_time_s": back["cost"]}
+    assert Dataset(changed, back.meta).differing_columns(data) == ["cost"]
+    assert not Dataset(changed, back.meta).same_rows(data)
 
 
 def test_killed_run_resumes_to_the_same_dataset(tmp_path: Path) -> None:

@@ -190,18 +190,29 @@ class Dataset:
 
     def same_rows(self, other: Dataset, *, ignore: Sequence[str] = TIMING_COLUMNS) -> bool:
         """Whether both hold the same rows (timings ignored), NaN equal to NaN."""
+        return len(self) == len(other) and not self.differing_columns(other, ignore=ignore)
+
+    def differing_columns(
+        self, other: Dataset, *, ignore: Sequence[str] = TIMING_COLUMNS
+    ) -> list[str]:
+        """The columns (``ignore`` left out) whose values differ, NaN equal to NaN.
+
+        Both datasets must have the same number of rows.
+        """
         if len(self) != len(other):
-            return False
+            raise ValueError(f"{len(self)} rows against {len(other)}")
+        out = []
         for name in COLUMNS:
             if name in ignore:
                 continue
             a, b = self[name], other[name]
             if a.dtype.kind in "fc":
-                if a.shape != b.shape or not np.array_equal(a, b, equal_nan=True):
-                    return False
-            elif not np.array_equal(a, b):
-                return False
-        return True
+                same = a.shape == b.shape and np.array_equal(a, b, equal_nan=True)
+            else:
+                same = np.array_equal(a, b)
+            if not same:
+                out.append(name)
+        return out
 
 
 def _pad(values: NDArray[Any], width: int) -> NDArray[Any]:
