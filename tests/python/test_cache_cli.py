@@ -53,3 +53,25 @@ def test_warm_reports_a_bad_structure(
     assert main([*args, "--duration", "0.1"]) == 1
     assert capsys.readouterr().out.startswith("not stored:")
     assert nlp_cache.entries() == []
+
+
+def test_warm_entry_serves_a_solve_with_the_default_iterations(nlp_cache_dir: Path) -> None:
+    # warm takes no iteration; the solves it prepares for take the config's.
+    from roughwalk.terrain import load_terrain
+    from roughwalk.trajopt import Task, optimize_motion, towr_config
+
+    assert main(_WARM) == 0
+    clear_cache()  # a new process would not have it in memory
+    result = optimize_motion(
+        None,
+        load_terrain("flat"),
+        Task((0.0, 0.0, 0.0), (0.5, 0.0, 0.0)),
+        config=towr_config(),
+        gait="trot",
+        steps=4,
+        duration=1.0,
+        compiled="auto",
+        max_iter=1,
+    )
+    assert result.build == "deserialized"
+    assert len(nlp_cache.entries()) == 1

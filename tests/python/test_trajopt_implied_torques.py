@@ -109,3 +109,19 @@ def test_a_plan_reports_its_largest_torque(anymal: Robot) -> None:
     assert found.limit_nm == 80.0
     assert 10.0 < found.max_nm < found.limit_nm  # a walk on flat ground stays within the motors
     assert found.to_dict()["joint"] == found.joint
+
+
+def test_over_limit_counts_a_weaker_joint_than_the_most_loaded() -> None:
+    # LittleDog's knees hold 1.4 N·m, its hips 2.5: a plan asking 2.2 of a hip
+    # and 2.0 of a knee passes the knee's limit though its largest torque does not.
+    from roughwalk.trajopt import ImpliedTorques
+
+    worst = ImpliedTorques(
+        max_nm=2.2,
+        time_s=0.5,
+        joint="LF_HFE",
+        limit_nm=2.5,
+        over_limit_fraction=0.1,
+        unreachable_fraction=0.0,
+    )
+    assert worst.over_limit

@@ -106,9 +106,16 @@ def structure_digest(
     """The cache key of one NLP structure (hex) for entries of ``kind``.
 
     The config decides the cost set and with it the Hessian (exact or L-BFGS).
-    ``kind`` is "compiled" (here) or "serialized" (:mod:`.serialized_nlp`):
-    the two kinds of one structure are separate entries.
+    Of the solver's options only ``hessian`` is part of the key: the others
+    (iteration and time limits, IPOPT's options) change how the functions are
+    solved, not the functions, and a solve with ``--max-iter`` (or ``roughwalk
+    cache warm``, which takes no iteration) must find the entry of the same
+    structure. ``kind`` is "compiled" (here) or "serialized"
+    (:mod:`.serialized_nlp`): the two kinds of one structure are separate entries.
     """
+    described = to_dict(config)
+    described.pop("compiled", None)
+    described["solver"] = {"hessian": described["solver"]["hessian"]}
     description = {
         "kind": kind,
         "body": repr(body),
@@ -116,12 +123,8 @@ def structure_digest(
         "schedule": repr(
             (schedule.name, schedule.durations, schedule.in_contact_at_start, schedule.steps)
         ),
-        # The whole config but the switch that chose the cache.
-        "config": json.dumps(
-            {k: v for k, v in to_dict(config).items() if k != "compiled"},
-            sort_keys=True,
-            default=repr,
-        ),
+        # The whole config but the switch that chose the cache and how IPOPT runs.
+        "config": json.dumps(described, sort_keys=True, default=repr),
         "casadi": ca.CasadiMeta.version(),
         "flags": (COMPILER_FLAGS, sorted(_CODEGEN_OPTIONS.items())) if kind == "compiled" else None,
         "source": _source_digest(),

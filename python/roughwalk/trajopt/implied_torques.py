@@ -59,8 +59,12 @@ class ImpliedTorques:
 
     @property
     def over_limit(self) -> bool:
-        """Whether the plan asks more than a joint's limit somewhere."""
-        return self.max_nm > self.limit_nm
+        """Whether the plan asks more than a joint's limit somewhere.
+
+        Not ``max_nm > limit_nm``: the most loaded joint may have the higher
+        limit (LittleDog's hips 2.5 N·m, knees 1.4) while another passes its own.
+        """
+        return self.over_limit_fraction > 0
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready fields (an infinite limit as None)."""
