@@ -66,8 +66,9 @@ class TimingConfig:
         into the next support triangle) for a ZMP travel of
         ``shift_travel_m`` or more. The cart-table needs time to move
         its ZMP: shorter shifts swing the trunk harder. The preview
-        controller starts the move ahead, so 0.2 s suffices on the
-        benchmark courses (0.3 s walked 20 % slower). The fast timing
+        controller starts the move ahead, so 0.1 s holds on the
+        benchmark courses after a 0.2 s first shift (``first_shift_s``;
+        0.3 s walked 20 % slower than 0.2). The fast timing
         (0.1 here, ``min_swing_s`` 0.2, ``swing.time_law`` "joint")
         against the defaults, the planner's budget fixed so that runs
         repeat (``roughwalk bench littledog --classes

@@ -79,9 +79,9 @@ class ImpliedTorques:
 
     def describe(self) -> str:
         """One line for people."""
-        limit = f" (limit {self.limit_nm:.0f})" if math.isfinite(self.limit_nm) else ""
+        limit = f" (limit {self.limit_nm:.3g})" if math.isfinite(self.limit_nm) else ""
         return (
-            f"the plan's forces ask up to {self.max_nm:.0f} N·m of {self.joint}{limit} "
+            f"the plan's forces ask up to {self.max_nm:.3g} N·m of {self.joint}{limit} "
             f"at {self.time_s:.2f} s; over a limit on {100 * self.over_limit_fraction:.0f} % "
             "of the samples"
         )

@@ -78,8 +78,8 @@ def save_tracking_picture(outcome: TrackingOutcome, path: str | Path, title: str
         # Where the plan's own forces ask the most of a joint: a dotted line and its figure.
         limit = implied["limit_nm"]
         headline += (
-            f"\nthe plan's forces ask up to {implied['max_nm']:.0f} N·m of {implied['joint']}"
-            f"{'' if limit is None else f' (limit {limit:.0f})'} at {implied['time_s']:.2f} s"
+            f"\nthe plan's forces ask up to {implied['max_nm']:.3g} N·m of {implied['joint']}"
+            f"{'' if limit is None else f' (limit {limit:.3g})'} at {implied['time_s']:.2f} s"
             f" (· · ·); over a limit on {100 * implied['over_limit_fraction']:.0f} % of the plan"
         )
         for ax in axes.ravel():
