@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 
 import pytest
@@ -75,3 +76,22 @@ def test_warm_entry_serves_a_solve_with_the_default_iterations(nlp_cache_dir: Pa
     )
     assert result.build == "deserialized"
     assert len(nlp_cache.entries()) == 1
+
+
+def test_a_killed_writer_s_leftover_is_listed_and_cleared_once_stale(
+    nlp_cache_dir: Path,
+) -> None:
+    nlp_cache_dir.mkdir(parents=True)
+    leftover = nlp_cache_dir / "0123abcd.tmp-xyz"
+    leftover.mkdir()
+    (leftover / "nlp.casadi").write_bytes(b"\0" * 1000)
+    # Young: a writer may be at work in it, so it is neither listed nor removed.
+    assert nlp_cache.entries() == []
+    assert nlp_cache.clear() == []
+    assert leftover.is_dir()
+    # Older than STALE_WRITE_S: its writer was killed.
+    later = time.time() + nlp_cache.STALE_WRITE_S + 1
+    (entry,) = nlp_cache.entries(now=later)
+    assert (entry.key, entry.kind, entry.size_bytes) == ("0123abcd", "unfinished", 1000)
+    assert [e.kind for e in nlp_cache.clear(kind="unfinished", now=later)] == ["unfinished"]
+    assert list(nlp_cache_dir.iterdir()) == []

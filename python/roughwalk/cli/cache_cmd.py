@@ -31,7 +31,7 @@ def register(sub: Any) -> None:
     clear = actions.add_parser("clear", help="remove stored NLPs")
     clear.add_argument(
         "--kind",
-        choices=("compiled", "serialized", "failed", "unreadable"),
+        choices=("compiled", "serialized", "failed", "unreadable", "unfinished"),
         help="only entries of this kind (default: all)",
     )
     clear.set_defaults(func=cmd_clear)
