@@ -5,6 +5,7 @@ from __future__ import annotations
 import ctypes
 import json
 import os
+import time
 from pathlib import Path
 
 import casadi as ca
@@ -552,3 +553,24 @@ def test_mumps_ordering_follows_durations_and_hessian(tmp_path: Path) -> None:
     assert metis["mumps_pivot_order"] == "5"
     amd = _ipopt_user_options(tmp_path, "amd", solver__hessian="exact", optimize_durations=True)
     assert amd["mumps_pivot_order"] == "0"
+
+
+def test_making_the_guess_counts_in_the_solve_time(monkeypatch: pytest.MonkeyPatch) -> None:
+    # solve_time_s runs from the task to the solution: a slow guess is part of it.
+    from roughwalk.trajopt.initializers import HeuristicInitializer
+
+    config = towr_config()
+    task = ((0.0, 0.0, 0.0), (0.3, 0.0, 0.0))
+    kwargs = {"config": config, "gait": "trot", "steps": 4, "duration": 1.0, "max_iter": 1}
+    optimize_motion(None, "flat", task, **kwargs)  # built: later solves reuse the structure
+    quick = optimize_motion(None, "flat", task, **kwargs)
+    guess = HeuristicInitializer.guess
+
+    def slow_guess(self: HeuristicInitializer, *args: object) -> np.ndarray:
+        time.sleep(0.5)
+        return guess(self, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(HeuristicInitializer, "guess", slow_guess)
+    slow = optimize_motion(None, "flat", task, **kwargs)
+    assert quick.build_time_s == slow.build_time_s == 0.0
+    assert slow.solve_time_s >= quick.solve_time_s + 0.45
