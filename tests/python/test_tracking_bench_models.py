@@ -5,6 +5,7 @@ from __future__ import annotations
 import shutil
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import pytest
 from _benchmarks import load_benchmark
@@ -40,15 +41,26 @@ def test_the_folder_s_model_that_fits_the_problem_is_used(candidate: Path) -> No
     assert costs is None  # the shipped model records no weights
 
 
+def _double_pallet_model_with(
+    bench: Any, costs: dict[str, float], folder: Path
+) -> tuple[str, Any, Any]:
+    """The shipped double-pallet model recording ``costs``, saved in ``folder``:
+    its ``--init`` value, and the constraint set and weights the bench solves it with."""
+    model = LearnedModel.load(DOUBLE)
+    model.header["costs"] = costs
+    model.save(folder / "recorded.npz")
+    init = bench.learned_init("double_pallet", False, folder)
+    constraints, recorded = bench.learned_problem("double_pallet", False, init)
+    return init, constraints, recorded
+
+
 def test_the_heuristic_start_solves_with_the_model_s_weights_too(tmp_path: Path) -> None:
     # Both starts must solve one NLP, objective included: a model trained with
     # a penalty gives it to the heuristic's jobs as well, and --trajopt wins.
-    model = LearnedModel.load(DOUBLE)
-    model.header["costs"] = {"force_between_nodes_penalty": 10.0}
-    model.save(tmp_path / "penalised.npz")
     bench = load_benchmark("bench_tracking")
-    init = bench.learned_init("double_pallet", False, tmp_path)
-    constraints, costs = bench.learned_problem("double_pallet", False, init)
+    init, constraints, costs = _double_pallet_model_with(
+        bench, {"force_between_nodes_penalty": 10.0}, tmp_path
+    )
     assert costs == (("force_between_nodes_penalty", 10.0),)
     task = {"max_iter": 0, "optimize_durations": False, "index": 0}
     task |= {"start": (0.0, 0.0, 0.0), "goal": (1.0, 0.0, 0.0)}
@@ -71,12 +83,8 @@ def test_the_heuristic_start_solves_with_the_model_s_weights_too(tmp_path: Path)
 
 
 def test_a_two_level_trajopt_weight_wins_over_the_model_s_recorded_one(tmp_path: Path) -> None:
-    model = LearnedModel.load(DOUBLE)
-    model.header["costs"] = {"force.weight": 0.2}
-    model.save(tmp_path / "force_weighted.npz")
     bench = load_benchmark("bench_tracking")
-    init = bench.learned_init("double_pallet", False, tmp_path)
-    constraints, costs = bench.learned_problem("double_pallet", False, init)
+    _, constraints, costs = _double_pallet_model_with(bench, {"force.weight": 0.2}, tmp_path)
     job = bench.Job(
         "double_pallet", "double_pallet", "heuristic", 0, False, 0, (0.0, 0.0, 0.0),
         (1.0, 0.0, 0.0), constraints=constraints, costs=costs,
