@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import textwrap
 from collections.abc import Iterator
 from dataclasses import replace
@@ -12,6 +10,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 import pytest
+from _cache_writers import race_two_writers
 
 from roughwalk.errors import ConfigError
 from roughwalk.terrain import load_terrain
@@ -149,14 +148,7 @@ _WRITER = textwrap.dedent(
 
 
 def test_concurrent_writers_leave_one_intact_entry(tmp_path: Path) -> None:
-    writers = [
-        subprocess.Popen([sys.executable, "-c", _WRITER, str(tmp_path)], stderr=subprocess.PIPE)
-        for _ in range(2)
-    ]
-    for writer in writers:
-        _, err = writer.communicate(timeout=300)
-        assert writer.returncode == 0, err.decode()
-    assert [p.name for p in tmp_path.iterdir()] == ["race"]  # no temporary directory left
+    race_two_writers(_WRITER, tmp_path, timeout_s=300)
     loaded = compiled_nlp.load("race", tmp_path)
     assert loaded is not None
     assert loaded.row_layout == [("box", 3)]
