@@ -219,8 +219,13 @@ impl LegChain {
         (h * h + best.0 * best.0, best.1, best.2)
     }
 
-    /// The joint angles within limits whose foot is closest to `target` (base frame [m]).
-    pub(super) fn closest_within_limits(&self, target: Vec3) -> Vec3 {
+    /// The joint angles within limits whose foot is closest to `target` (base
+    /// frame [m]). `extra_seed` (the analytic IK's clamped candidate) is
+    /// refined too: the scan keeps one planar basin per HAA slice, and where
+    /// two basins (the HFE at either limit, say) lie at nearly the same HAA
+    /// the scan can miss the better; the extra seed makes the answer never
+    /// farther than the cheap clamped answer of `ik_or_clamped`.
+    pub(super) fn closest_within_limits(&self, target: Vec3, extra_seed: Option<Vec3>) -> Vec3 {
         let t = self.target_at_hip(target);
         let full = self.scan.full;
         let q1_at = |i: usize| self.scan.q1[i];
@@ -244,9 +249,11 @@ impl LegChain {
             .collect();
         minima.sort_by(|&a, &b| value(a).total_cmp(&value(b)));
         let mut best = (self.nominal(), f64::INFINITY);
-        for &i in minima.iter().take(REFINED) {
+        let scan_seeds = minima.iter().take(REFINED).map(|&i| {
             let (_, q2, phi) = slices[i];
-            let seed = [q1_at(i), q2, self.ik_geometry.knee_axis_sign * phi];
+            [q1_at(i), q2, self.ik_geometry.knee_axis_sign * phi]
+        });
+        for seed in scan_seeds.chain(extra_seed) {
             let (q, err) = self.projected_newton(seed, target);
             if err < best.1 {
                 best = (q, err);

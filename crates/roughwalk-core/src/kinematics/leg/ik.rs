@@ -266,7 +266,11 @@ impl LegChain {
         if let Some(found) = self.ik_exact_at(solve_target, target, knee_sign, &mut frames) {
             return (found, frames);
         }
-        let q = self.closest_within_limits(solve_target);
+        let clamped = match self.analytic(solve_target, target, knee_sign, true, &mut frames) {
+            Analytic::Nearest(nearest) => nearest.map(|(_, q)| q),
+            Analytic::Reached(_) => None,
+        };
+        let q = self.closest_within_limits(solve_target, clamped);
         let frames = self.link_frames(q);
         let foot = add(frames.pos[2], mat_vec(&frames.rot[2], self.params.foot));
         let error = norm(sub(foot, target));
