@@ -95,3 +95,13 @@ def test_a_killed_writer_s_leftover_is_listed_and_cleared_once_stale(
     assert (entry.key, entry.kind, entry.size_bytes) == ("0123abcd", "unfinished", 1000)
     assert [e.kind for e in nlp_cache.clear(kind="unfinished", now=later)] == ["unfinished"]
     assert list(nlp_cache_dir.iterdir()) == []
+
+
+def test_warm_refuses_a_robot_the_named_body_ignores(
+    nlp_cache_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The towr preset's body is TOWR's published ANYmal: a --robot would be ignored.
+    assert main([*_WARM, "--robot", "littledog"]) != 0
+    err = capsys.readouterr().err
+    assert "--robot littledog has no effect" in err and "towr_anymal" in err
+    assert nlp_cache.entries() == []

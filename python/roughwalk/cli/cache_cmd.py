@@ -47,7 +47,11 @@ def register(sub: Any) -> None:
     warm.add_argument(
         "--preset", choices=("melon", "towr"), default="melon", help="base configuration"
     )
-    warm.add_argument("--robot", default="anymal_c", help="a registered robot or an MJCF path")
+    warm.add_argument(
+        "--robot",
+        help="a registered robot or an MJCF path (default anymal_c; only where the "
+        "config's body_model is 'robot': the towr preset's body is a fixed parameter set)",
+    )
     warm.add_argument("--terrain", default="flat", help="a terrain spec")
     warm.add_argument("--gait", help="walk, trot, pace, bound or gallop")
     warm.add_argument("--steps", type=int, help="number of swings of all feet")
@@ -110,6 +114,7 @@ def cmd_clear(args: argparse.Namespace) -> int:
 def cmd_warm(args: argparse.Namespace) -> int:
     """Build and store one NLP structure (no iteration is taken)."""
     from roughwalk.config import configure
+    from roughwalk.errors import InvalidArgumentError
     from roughwalk.robots import load_robot
     from roughwalk.terrain import load_terrain
     from roughwalk.trajopt import Task, melon_config, optimize_motion, towr_config
@@ -123,7 +128,15 @@ def cmd_warm(args: argparse.Namespace) -> int:
             overrides[field] = value
     if args.optimize_durations:
         overrides["optimize_durations"] = True
-    robot = load_robot(args.robot) if config.body_model == "robot" else None
+    if config.body_model != "robot" and args.robot is not None:
+        # The structure would be the named body's whatever robot was asked for:
+        # storing it under the asker's belief would be a silent surprise.
+        raise InvalidArgumentError(
+            f"--robot {args.robot} has no effect: the config's body_model is "
+            f"'{config.body_model}', a fixed parameter set; drop --robot, or add "
+            "--set body_model=robot to take the body from the robot's model"
+        )
+    robot = load_robot(args.robot or "anymal_c") if config.body_model == "robot" else None
     terrain = load_terrain(args.terrain)
     # Any task will do: the structure does not depend on it.
     task = Task((0.0, 0.0, 0.0), (0.5, 0.0, 0.0))
