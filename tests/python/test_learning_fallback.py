@@ -36,6 +36,14 @@ def test_a_stuck_library_pick_restarts_from_the_network_guess_and_converges() ->
     # Both solves are paid for: the first's iterations, then the restart's.
     assert after < result.iterations <= 100
     assert result.history[-1]["iteration"] == result.iterations
+    # The restart's starting point shares its number with the first solve's
+    # last iteration; the entries say which solve they belong to, and time runs on.
+    first = [h for h in result.history if h["solve"] == 0.0]
+    second = [h for h in result.history if h["solve"] == 1.0]
+    assert first and second and len(first) + len(second) == len(result.history)
+    assert second[0]["iteration"] == first[-1]["iteration"]
+    elapsed = [h["elapsed_s"] for h in result.history]
+    assert all(b >= a for a, b in zip(elapsed, elapsed[1:], strict=False))
 
 
 def test_experience_runs_from_a_model_fall_back_too(tmp_path: Path) -> None:

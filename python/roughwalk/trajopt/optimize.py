@@ -332,13 +332,22 @@ def _joined(first: SolveOutcome, second: SolveOutcome, nlp: Formulation) -> Solv
     """The restart's outcome, unless the first ended nearer feasible; both solves' cost.
 
     Iterations and time are the sum of both solves (the restart is paid for);
-    the history runs on, the restart's iterations numbered after the first's.
+    the history runs on: the restart's iterations are numbered after the first's
+    and its times after the first's time, and every entry says which solve it
+    comes from (``solve`` 0 or 1). The restart's iteration 0 is its own starting
+    point, so its number is the first solve's last one: the key tells them apart.
     """
     chosen = second
     if not second.status.solved and _max_violation(first, nlp) < _max_violation(second, nlp):
         chosen = first
-    history = list(first.history) + [
-        {**h, "iteration": h.get("iteration", 0) + first.iterations} for h in second.history
+    history = [{**h, "solve": 0.0} for h in first.history] + [
+        {
+            **h,
+            "iteration": h.get("iteration", 0) + first.iterations,
+            "elapsed_s": h.get("elapsed_s", 0.0) + first.solve_time_s,
+            "solve": 1.0,
+        }
+        for h in second.history
     ]
     return replace(
         chosen,

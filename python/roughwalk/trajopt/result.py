@@ -127,7 +127,8 @@ class TrajoptResult:
     return_status:
         IPOPT's own return status.
     history:
-        Per iteration: objective, violation and elapsed time.
+        Per iteration: objective, violation and elapsed time; after a restart
+        from an initialiser's fallback guess, also which solve (0, 1) it is of.
     x:
         The solution vector (for warm starts).
     lam_x, lam_g:
