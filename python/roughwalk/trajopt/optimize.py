@@ -122,6 +122,9 @@ class TrajoptProblem:
             self.build = "cached"
             return Formulation(cfg, body, schedule, terrain, compiled=loaded)
         built = None
+        serial_key = compiled_nlp.structure_digest(
+            body, terrain_key, schedule, cfg, kind=serialized_nlp.KIND
+        )
         if cfg.compiled == "on" and not compiled_nlp.failed_before(key):
             built = Formulation(cfg, body, schedule, terrain)
             try:
@@ -130,15 +133,16 @@ class TrajoptProblem:
                 )
             except compiled_nlp.CompileError as e:
                 warnings.warn(f"{e}; solving with CasADi's serialised functions", stacklevel=3)
+                if serialized_nlp.exists(serial_key):
+                    # Stored by an earlier "auto" run: nothing to write, and the
+                    # expressions just built serve this solve.
+                    return built
             else:
                 loaded = compiled_nlp.load(key)
                 if loaded is None:
                     return built
                 self.build = "compiled"
                 return Formulation(cfg, body, schedule, terrain, compiled=loaded)
-        serial_key = compiled_nlp.structure_digest(
-            body, terrain_key, schedule, cfg, kind=serialized_nlp.KIND
-        )
         if built is None:
             loaded = serialized_nlp.load(serial_key)
             if loaded is not None:

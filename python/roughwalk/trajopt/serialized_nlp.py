@@ -103,6 +103,11 @@ def load(key: str, root: Path | None = None) -> CompiledNlp | None:
         return None
 
 
+def exists(key: str, root: Path | None = None) -> bool:
+    """Whether entry ``key`` is stored (whole or not: :func:`load` checks that)."""
+    return ((root or cache_dir()) / key).is_dir()
+
+
 def store(
     key: str, functions: dict[str, ca.Function], layout: dict[str, Any], root: Path | None = None
 ) -> Path:
