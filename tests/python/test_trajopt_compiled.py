@@ -113,6 +113,8 @@ def test_the_key_follows_everything_that_defines_the_structure() -> None:
     assert _digest(dt_dynamics=0.05) != base
     assert _digest(constraints=("dynamics",)) != base
     assert _digest(terrain="towr_block") != base
+    # Where the guess comes from and how the result is sampled build nothing.
+    assert _digest(init="footsteps", sample_rate_hz=50.0) == base
     heavier = replace(TOWR_ANYMAL, mass=TOWR_ANYMAL.mass + 1.0)
     schedule = make_gait("trot", 4, 1.0)
     config = towr_config(body_model="towr_anymal")
