@@ -27,7 +27,12 @@ from roughwalk.errors import ConfigError
 from roughwalk.learning.dataset import COLUMNS, Dataset
 from roughwalk.learning.executors import Executor, LocalExecutor
 from roughwalk.learning.model_costs import cost_changes
-from roughwalk.learning.problem_spec import ProblemSpec, build_problem, variable_layout
+from roughwalk.learning.problem_spec import (
+    ProblemSpec,
+    build_problem,
+    task_refusal,
+    variable_layout,
+)
 from roughwalk.learning.task_space import TaskSpace
 from roughwalk.trajopt import (
     ContactSchedule,
@@ -369,6 +374,20 @@ def generate(
         },
     )
     wanted = list(range(n_tasks)) if indices is None else sorted(set(indices))
+    # Tasks the problem refuses (a start no solve can leave) are not solved:
+    # the run records why, and the dataset leaves them out.
+    refused = {
+        i: reason
+        for i in wanted
+        if (reason := task_refusal(spec, space.task(i, seed=seed, split=split))) is not None
+    }
+    if refused:
+        run.meta["refused"] = {
+            **run.meta.get("refused", {}),
+            **{str(i): r for i, r in refused.items()},
+        }
+        run._write_meta()
+        wanted = [i for i in wanted if i not in refused]
     done = run.done()
     todo = [i for i in wanted if i not in done]
     tasks = [space.task(i, seed=seed, split=split) for i in todo]

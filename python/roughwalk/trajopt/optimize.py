@@ -41,9 +41,8 @@ from roughwalk.trajopt.solver import (
 from roughwalk.trajopt.task import (
     ResolvedTask,
     Task,
-    level_stance_problems,
     resolve,
-    stance_problems,
+    task_problems,
 )
 from roughwalk.trajopt.terrain_model import TerrainModel
 from roughwalk.trajopt.variables import NumericSpline
@@ -557,10 +556,7 @@ def optimize_motion(
                     lambda: TerrainModel(terrain_obj, cfg.terrain, cfg.costs.step_edge_sigma),
                 )
     problems = _schedule_problems(schedule, cfg)
-    problems += stance_problems(body, terrain_model, the_task.start, "start")
-    problems += stance_problems(body, terrain_model, the_task.goal, "goal")
-    if not problems and {"goal_state", "range_of_motion"} <= set(cfg.constraints):
-        problems += level_stance_problems(body, terrain_model, the_task.goal, "goal")
+    problems += task_problems(body, terrain_model, the_task, tuple(cfg.constraints))
     if problems:
         return _invalid(
             the_task,
