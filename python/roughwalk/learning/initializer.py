@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from roughwalk.errors import ConfigError
 from roughwalk.learning.model_constraints import constraints_for_model
 from roughwalk.learning.model_costs import costs_for_model
-from roughwalk.learning.model_file import LearnedModel, problem_signature
+from roughwalk.learning.model_file import LearnedModel, Start, problem_signature
 from roughwalk.learning.problem_spec import ProblemSpec
 from roughwalk.learning.solution_library import farthest
 from roughwalk.trajopt import ContactSchedule, Formulation, register_initializer
@@ -222,9 +222,7 @@ class LearnedInitializer:
 
 def choose_start(
     nlp: Formulation,
-    pool: Sequence[
-        tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]
-    ],
+    pool: Sequence[Start],
     visited: Sequence[NDArray[np.float64]],
     scale: NDArray[np.float64],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None] | None:
@@ -238,12 +236,13 @@ def choose_start(
 
 def bounded_start(
     nlp: Formulation,
-    start: tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None],
+    start: Start,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]:
     """A start within ``nlp``'s variable bounds, its lam_g padded for appended rows."""
     x, lam_x, lam_g = start
-    rows = None if lam_g is None else _complete_rows(nlp, np.asarray(lam_g))
-    return np.clip(np.asarray(x, dtype=float), nlp.lbx, nlp.ubx), lam_x, rows
+    rows = None if lam_g is None else _complete_rows(nlp, np.asarray(lam_g, dtype=float))
+    bound = None if lam_x is None else np.asarray(lam_x, dtype=float)
+    return np.clip(np.asarray(x, dtype=float), nlp.lbx, nlp.ubx), bound, rows
 
 
 def _complete_rows(nlp: Formulation, lam_g: NDArray[np.float64]) -> NDArray[np.float64]:

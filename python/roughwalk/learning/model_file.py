@@ -35,7 +35,7 @@ FEATURES = ("start_x", "start_y", "start_yaw", "goal_x", "goal_y", "goal_yaw")
 # What must match, in the order a mismatch is reported.
 _CHECKED = ("robot", "gait", "steps", "duration", "optimize_durations", "terrain")
 
-Start = tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]
+Start = tuple[NDArray[np.floating], NDArray[np.floating] | None, NDArray[np.floating] | None]
 """A start for IPOPT: the guess, its bound multipliers and constraint multipliers (or None)."""
 
 
@@ -185,10 +185,9 @@ class LearnedModel:
         near = self.library.nearest(features, self.library.candidates)[0]
         lam_x, _ = self.predict_multipliers([task])
         bound = None if lam_x is None else lam_x[0]
-        return [
-            (self.library.x[j].astype(float), bound, self.library.lam_g[j].astype(float))
-            for j in near
-        ]
+        # The library's own float32 rows, not copies: a run of 2000 tasks holds
+        # ten candidates for each of its jobs.
+        return [(self.library.x[j], bound, self.library.lam_g[j]) for j in near]
 
     def predict(self, task: Task) -> NDArray[np.float64]:
         """The initial guess (n_variables,) for one task."""
