@@ -12,6 +12,7 @@ from roughwalk.errors import ConfigError, InvalidArgumentError
 from roughwalk.learning import Dataset, ProblemSpec, TaskSpace, generate
 from roughwalk.learning.dataset import COLUMNS
 from roughwalk.learning.experience import jittered, read_run
+from roughwalk.learning.problem_spec import task_refusal
 
 SPEC = ProblemSpec("anymal_c", "flat", "walk", 4, 2.0)
 SPACE = TaskSpace("flat_small", "flat", (-0.1, -0.1, -0.2), (0.1, 0.1, 0.2), (0.4, 0.0, 0.0))
@@ -234,3 +235,19 @@ def test_generate_cli_selects_far_starts_and_checks_jitter(
         assert main([*common, "--tasks", "1", "--out", str(tmp_path / "bad"), *bad]) == 1
         assert says in capsys.readouterr().err
     assert not (tmp_path / "bad" / "dataset.npz").exists()
+
+
+def test_a_run_leaves_out_the_tasks_the_problem_refuses(tmp_path: Path) -> None:
+    # Starts at held-out single-pallet task 189's: near the edge, turned right, one
+    # front foot up the smoothed edge beyond its range of motion on some of them.
+    spec = ProblemSpec("anymal_c", "single_pallet", "walk", 4, 2.0)
+    space = TaskSpace(
+        "edge", "single_pallet", (0.40, 0.30, -0.39), (0.50, 0.33, -0.38), (1.6, 0.0, 0.0)
+    )
+    refused = [i for i in range(6) if task_refusal(spec, space.task(i)) is not None]
+    assert 0 < len(refused) < 6
+    data = generate(spec, space, 6, tmp_path / "run", max_iter=1, progress=None)
+    assert sorted(set(range(6)) - set(data["index"].tolist())) == refused
+    meta = json.loads((tmp_path / "run" / "run.json").read_text())
+    assert sorted(int(i) for i in meta["refused"]) == refused
+    assert all("range of motion" in reason for reason in meta["refused"].values())

@@ -27,7 +27,12 @@ from roughwalk.errors import ConfigError
 from roughwalk.learning.dataset import COLUMNS, Dataset
 from roughwalk.learning.executors import Executor, LocalExecutor
 from roughwalk.learning.model_costs import cost_changes
-from roughwalk.learning.problem_spec import ProblemSpec, build_problem, variable_layout
+from roughwalk.learning.problem_spec import (
+    ProblemSpec,
+    build_problem,
+    task_refusal,
+    variable_layout,
+)
 from roughwalk.learning.task_space import TaskSpace
 from roughwalk.trajopt import (
     ContactSchedule,
@@ -39,7 +44,7 @@ from roughwalk.trajopt import (
 from roughwalk.trajopt.task import ResolvedTask, resolve
 
 if TYPE_CHECKING:
-    from roughwalk.learning.model_file import LearnedModel
+    from roughwalk.learning.model_file import LearnedModel, Start
 
 __all__ = [
     "SolveJob",
@@ -73,6 +78,12 @@ class SolveJob:
         tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None] | None
     ) = None
     """A second start (guess, lam_x, lam_g): a library model's network guess."""
+    cost_limit: float | None = None
+    """The cost above which a converged solve is started again from ``restarts``."""
+    restarts: tuple[Start, ...] = ()
+    """Further starts for a converged solve dearer than ``cost_limit`` (library candidates)."""
+    restart_scale: NDArray[np.float64] | None = None
+    """The distance scale :func:`~roughwalk.learning.solution_library.farthest` chooses them in."""
 
 
 class FixedGuess:
@@ -94,9 +105,15 @@ class FixedGuess:
             tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]
             | None
         ) = None,
+        cost_limit: float | None = None,
+        restarts: tuple[Start, ...] = (),
+        restart_scale: NDArray[np.float64] | None = None,
     ) -> None:
         self.x0, self.lam_x0, self.lam_g0 = x0, lam_x0, lam_g0
         self._fallback = fallback
+        self._cost_limit = cost_limit
+        self._restarts = restarts
+        self._restart_scale = restart_scale
 
     def has_fallback(self, nlp: Formulation) -> bool:
         """Whether a fallback start was given."""
@@ -112,6 +129,20 @@ class FixedGuess:
         x1, lam_x1, lam_g1 = self._fallback
         lam_g = None if lam_g1 is None else _complete_rows(nlp, np.asarray(lam_g1))
         return np.clip(np.asarray(x1, dtype=float), nlp.lbx, nlp.ubx), lam_x1, lam_g
+
+    def cost_limit(self, nlp: Formulation, task: ResolvedTask) -> float | None:
+        """The given cost limit (None: never start again)."""
+        return self._cost_limit
+
+    def other_start(
+        self, nlp: Formulation, task: ResolvedTask, visited: Sequence[NDArray[np.float64]]
+    ) -> Start | None:
+        """The given further start farthest from every start and solution so far, or None."""
+        from roughwalk.learning.initializer import choose_start
+
+        if self._restart_scale is None:
+            return None
+        return choose_start(nlp, self._restarts, visited, self._restart_scale)
 
     def schedule(self, gait: ContactSchedule) -> ContactSchedule:
         """The gait's schedule."""
@@ -187,7 +218,9 @@ def solve_job(job: SolveJob) -> dict[str, Any]:
         x0 = HeuristicInitializer().guess(problem.formulation, resolved)
     else:
         x0 = np.asarray(job.x0, dtype=float)
-    guess = FixedGuess(x0, job.lam_x0, job.lam_g0, job.fallback)
+    guess = FixedGuess(
+        x0, job.lam_x0, job.lam_g0, job.fallback, job.cost_limit, job.restarts, job.restart_scale
+    )
     result = problem.solve(job.task, guess, max_iter=job.max_iter)
     return result_row(job.index, result, x0)
 
@@ -369,6 +402,20 @@ def generate(
         },
     )
     wanted = list(range(n_tasks)) if indices is None else sorted(set(indices))
+    # Tasks the problem refuses (a start no solve can leave) are not solved:
+    # the run records why, and the dataset leaves them out.
+    refused = {
+        i: reason
+        for i in wanted
+        if (reason := task_refusal(spec, space.task(i, seed=seed, split=split))) is not None
+    }
+    if refused:
+        run.meta["refused"] = {
+            **run.meta.get("refused", {}),
+            **{str(i): r for i, r in refused.items()},
+        }
+        run._write_meta()
+        wanted = [i for i in wanted if i not in refused]
     done = run.done()
     todo = [i for i in wanted if i not in done]
     tasks = [space.task(i, seed=seed, split=split) for i in todo]
@@ -378,6 +425,9 @@ def generate(
         x0s = model.predict_tasks(asked)
         lam_x, lam_g = model.predict_multipliers(asked)
         fallbacks = _network_starts(model, asked)
+        # Further starts for a solve that converges dear (solver.dear_guess_restarts).
+        n_restarts = spec.config().solver.dear_guess_restarts
+        limits = model.cost_limits(tasks) if n_restarts > 0 else None
         jobs = [
             SolveJob(
                 spec,
@@ -388,6 +438,9 @@ def generate(
                 None if lam_x is None else lam_x[k],
                 None if lam_g is None else lam_g[k],
                 fallbacks[k],
+                None if limits is None else float(limits[k]),
+                tuple(model.other_starts(asked[k])) if limits is not None else (),
+                model.mlp.out_scale,
             )
             for k, job in enumerate(jobs)
         ]

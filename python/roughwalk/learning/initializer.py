@@ -9,6 +9,7 @@ The contact schedule and the task are left as they are.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -17,13 +18,22 @@ from numpy.typing import NDArray
 from roughwalk.errors import ConfigError
 from roughwalk.learning.model_constraints import constraints_for_model
 from roughwalk.learning.model_costs import costs_for_model
-from roughwalk.learning.model_file import LearnedModel, problem_signature
+from roughwalk.learning.model_file import LearnedModel, Start, problem_signature
 from roughwalk.learning.problem_spec import ProblemSpec
+from roughwalk.learning.solution_library import farthest
 from roughwalk.trajopt import ContactSchedule, Formulation, register_initializer
 from roughwalk.trajopt.parameters import CostWeights
 from roughwalk.trajopt.task import ResolvedTask
 
-__all__ = ["LearnedInitializer", "MODELS_DIR", "shipped_models", "load_model", "model_for_spec"]
+__all__ = [
+    "LearnedInitializer",
+    "MODELS_DIR",
+    "shipped_models",
+    "load_model",
+    "model_for_spec",
+    "bounded_start",
+    "choose_start",
+]
 
 MODELS_DIR = Path(__file__).resolve().parent / "models"
 
@@ -183,6 +193,56 @@ class LearnedInitializer:
         if lam_x is None or lam_g is None:
             return x0, None, None
         return x0, lam_x[0], _complete_rows(nlp, lam_g[0])
+
+    def cost_limit(self, nlp: Formulation, task: ResolvedTask) -> float | None:
+        """The cost above which a converged solve is a poor minimum: the model's per-task g_max.
+
+        A solve from the guess that ends dearer is started again from
+        :meth:`other_start` (``solver.dear_guess_restarts``); None (a model
+        without a task cost model) never restarts.
+        """
+        if self.model is None:
+            self.model = _pick(problem_signature(nlp))
+        limits = self.model.cost_limits([task.task])
+        return None if limits is None else float(limits[0])
+
+    def other_start(
+        self, nlp: Formulation, task: ResolvedTask, visited: Sequence[NDArray[np.float64]]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None] | None:
+        """A further start: the library candidate farthest from every start and solution so far.
+
+        None when the model has no library or every candidate was tried.
+        """
+        if self.model is None:
+            self.model = _pick(problem_signature(nlp))
+        return choose_start(
+            nlp, self.model.other_starts(task.task), visited, self.model.mlp.out_scale
+        )
+
+
+def choose_start(
+    nlp: Formulation,
+    pool: Sequence[Start],
+    visited: Sequence[NDArray[np.float64]],
+    scale: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None] | None:
+    """The start of ``pool`` farthest from ``visited`` (:func:`farthest`), within the bounds."""
+    if not pool:
+        return None
+    starts = [bounded_start(nlp, start) for start in pool]
+    k = farthest([x for x, _, _ in starts], visited, scale)
+    return None if k is None else starts[k]
+
+
+def bounded_start(
+    nlp: Formulation,
+    start: Start,
+) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]:
+    """A start within ``nlp``'s variable bounds, its lam_g padded for appended rows."""
+    x, lam_x, lam_g = start
+    rows = None if lam_g is None else _complete_rows(nlp, np.asarray(lam_g, dtype=float))
+    bound = None if lam_x is None else np.asarray(lam_x, dtype=float)
+    return np.clip(np.asarray(x, dtype=float), nlp.lbx, nlp.ubx), bound, rows
 
 
 def _complete_rows(nlp: Formulation, lam_g: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -41,9 +41,8 @@ from roughwalk.trajopt.solver import (
 from roughwalk.trajopt.task import (
     ResolvedTask,
     Task,
-    level_stance_problems,
     resolve,
-    stance_problems,
+    task_problems,
 )
 from roughwalk.trajopt.terrain_model import TerrainModel
 from roughwalk.trajopt.variables import NumericSpline
@@ -228,6 +227,8 @@ class TrajoptProblem:
             callback,
             predicted,
         )
+        notes = []
+        visited = [x0, outcome.x]  # the starts and solutions so far, for further starts
         if falls_back and _restartable(outcome.status):
             guessed = time.perf_counter()
             x1, lam_x1, lam_g1 = initializer.fallback(nlp, resolved)  # type: ignore[attr-defined]
@@ -243,13 +244,57 @@ class TrajoptProblem:
                 callback,
                 predicted,
             )
-            result = self._result(task, _joined(outcome, second, nlp), build, extra_time_s)
-            result.message += (
-                f"; restarted from the initialiser's fallback guess after "
+            notes.append(
+                f"restarted from the initialiser's fallback guess after "
                 f"{outcome.iterations} iterations from its first"
             )
-            return result
-        return self._result(task, outcome, build, extra_time_s)
+            visited += [x1, second.x]
+            outcome = _joined(outcome, second, nlp)
+        restarts = self.config.solver.dear_guess_restarts
+        cost_limit = getattr(initializer, "cost_limit", None)
+        if predicted and restarts > 0 and callable(cost_limit):
+            guessed = time.perf_counter()
+            ceiling = cost_limit(nlp, resolved)
+            extra_time_s += time.perf_counter() - guessed
+            tried = 0
+            while (
+                ceiling is not None
+                and tried < restarts
+                and outcome.status.solved
+                and outcome.objective > ceiling
+                and outcome.iterations < limit
+                and outcome.solve_time_s < seconds
+            ):
+                guessed = time.perf_counter()
+                start = initializer.other_start(nlp, resolved, visited)  # type: ignore[attr-defined]
+                extra_time_s += time.perf_counter() - guessed
+                if start is None:
+                    break
+                x2, lam_x2, lam_g2 = start
+                other = self._solve_from(
+                    resolved,
+                    x2,
+                    lam_x2,
+                    lam_g2,
+                    limit - outcome.iterations,
+                    seconds - outcome.solve_time_s,
+                    callback,
+                    predicted,
+                )
+                visited += [x2, other.x]
+                outcome = _cheaper(outcome, other)
+                tried += 1
+                if other.status in (TrajoptStatus.CANCELLED, TrajoptStatus.TIMEOUT):
+                    break
+            if tried:
+                notes.append(
+                    f"{tried} more start(s) after a converged cost above the initialiser's "
+                    f"limit {ceiling:.4g}; the cheapest kept ({outcome.objective:.4g})"
+                )
+        result = self._result(task, outcome, build, extra_time_s)
+        if notes:
+            result.message += "; " + "; ".join(notes)
+        return result
 
     def _solve_from(
         self,
@@ -357,6 +402,23 @@ def _joined(first: SolveOutcome, second: SolveOutcome, nlp: Formulation) -> Solv
         chosen,
         iterations=first.iterations + second.iterations,
         solve_time_s=first.solve_time_s + second.solve_time_s,
+        history=history,
+    )
+
+
+def _cheaper(kept: SolveOutcome, other: SolveOutcome) -> SolveOutcome:
+    """The cheaper converged outcome of a converged ``kept`` and a further start's; both paid.
+
+    Iterations and time are the sum of both solves; the history runs on.
+    """
+    chosen = other if other.status.solved and other.objective < kept.objective else kept
+    history = list(kept.history) + [
+        {**h, "iteration": h.get("iteration", 0) + kept.iterations} for h in other.history
+    ]
+    return replace(
+        chosen,
+        iterations=kept.iterations + other.iterations,
+        solve_time_s=kept.solve_time_s + other.solve_time_s,
         history=history,
     )
 
@@ -570,10 +632,7 @@ def optimize_motion(
                     lambda: TerrainModel(terrain_obj, cfg.terrain, cfg.costs.step_edge_sigma),
                 )
     problems = _schedule_problems(schedule, cfg)
-    problems += stance_problems(body, terrain_model, the_task.start, "start")
-    problems += stance_problems(body, terrain_model, the_task.goal, "goal")
-    if not problems and {"goal_state", "range_of_motion"} <= set(cfg.constraints):
-        problems += level_stance_problems(body, terrain_model, the_task.goal, "goal")
+    problems += task_problems(body, terrain_model, the_task, tuple(cfg.constraints))
     if problems:
         return _invalid(
             the_task,

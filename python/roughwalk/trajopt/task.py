@@ -24,7 +24,15 @@ from roughwalk.trajopt.robot_model import SingleRigidBody
 from roughwalk.trajopt.terrain_model import TerrainModel
 from roughwalk.trajopt.variables.base_angular import euler_to_rotation
 
-__all__ = ["Task", "ResolvedTask", "TASK_SIZE", "parse_pose", "level_stance_problems"]
+__all__ = [
+    "Task",
+    "ResolvedTask",
+    "TASK_SIZE",
+    "parse_pose",
+    "level_stance_problems",
+    "start_reach_problems",
+    "task_problems",
+]
 
 # p = [start pos (3), start euler (3), start feet (12), goal xy (2), goal euler (3), goal z (1)]
 TASK_SIZE = 24
@@ -235,3 +243,61 @@ def level_stance_problems(
         f"{what} ({x:g}, {y:g}): no level base can stand there: its feet's reach holds no "
         f"ground within {2 * dz:.2f} m of one height (the range-of-motion box)"
     ]
+
+
+_LEGS = ("LF", "RF", "LH", "RH")  # the order of SingleRigidBody.stance
+_REACH_TOLERANCE = 1e-4  # [m] the solver's constraint tolerance (``solver.constr_viol_tol``)
+
+
+def start_reach_problems(
+    body: SingleRigidBody, terrain: TerrainModel, pose: tuple[float, float, float], what: str
+) -> list[str]:
+    """Say which feet of the start stance at ``pose`` lie outside their range of motion.
+
+    The start is fixed, not free (:func:`resolve`): a level base at the mean
+    foot height plus the nominal height, the feet at their nominal footholds
+    on the ground. Where the ground under the footholds is uneven (a foot on
+    a pallet's smoothed edge, the others below it), a foot can sit further
+    from the base than its range-of-motion box allows, and no solve can meet
+    both the start and the box at t = 0. Held-out single-pallet task 189
+    (start (0.495, 0.317, −0.387)) is such a task: its left front foot rests
+    0.161 m up the edge, 0.121 m above its nominal height against a reach of
+    0.102, and IPOPT ends locally infeasible from every guess, the start
+    rows 0.0187 m off.
+    """
+    x, y, yaw = pose
+    feet, z = nominal_feet(body, terrain, x, y, yaw)
+    rot = euler_to_rotation(np.array([0.0, 0.0, yaw]))
+    off = (feet - np.array([x, y, z])) @ rot - body.stance  # (4, 3) in the base frame
+    excess = np.abs(off) - np.asarray(body.max_deviation)
+    out = []
+    for foot in np.flatnonzero(excess.max(axis=1) > _REACH_TOLERANCE):
+        axis = int(np.argmax(excess[foot]))
+        out.append(
+            f"{what} ({x:g}, {y:g}, yaw {yaw:g}): the {_LEGS[foot]} foot of its stance is "
+            f"{abs(off[foot, axis]):.3f} m from its nominal position along "
+            f"{'xyz'[axis]} (the range of motion allows {body.max_deviation[axis]:.3f} m): "
+            "the ground under the start footholds is too uneven for a level base"
+        )
+    return out
+
+
+def task_problems(
+    body: SingleRigidBody, terrain: TerrainModel, task: Task, constraints: tuple[str, ...]
+) -> list[str]:
+    """Every reason ``task`` cannot be solved on ``terrain`` under ``constraints`` (empty: none).
+
+    The start's and the goal's stances (:func:`stance_problems`); with the
+    start state and the range of motion both enforced, the start stance's
+    reach (:func:`start_reach_problems`); with the goal state too, whether
+    a level goal base can stand at all (:func:`level_stance_problems`).
+    """
+    problems = stance_problems(body, terrain, task.start, "start")
+    problems += stance_problems(body, terrain, task.goal, "goal")
+    if problems or "range_of_motion" not in constraints:
+        return problems
+    if "initial_state" in constraints:
+        problems += start_reach_problems(body, terrain, task.start, "start")
+    if "goal_state" in constraints:
+        problems += level_stance_problems(body, terrain, task.goal, "goal")
+    return problems

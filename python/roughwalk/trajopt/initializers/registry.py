@@ -8,7 +8,10 @@ it): a learned model's guess belongs to the set it was trained on; one
 with ``costs(requested, signature)`` likewise chooses the cost weights. One
 with ``has_fallback(nlp)`` and ``fallback(nlp, task)`` offers a second
 start (guess and multipliers) for a solve from its guess that has not
-converged after ``solver.guess_fallback_after`` iterations. Other
+converged after ``solver.guess_fallback_after`` iterations; one with
+``cost_limit(nlp, task)`` and ``other_start(nlp, task, visited)`` offers
+further starts for a solve that converged above that cost (a poor local
+minimum), up to ``solver.dear_guess_restarts`` of them. Other
 wings add theirs with :func:`register_initializer`; the learning wing
 registers ``learned`` (Melon 2020, §IV) when it is imported, since this wing
 may not import the wings above it.
