@@ -6,13 +6,16 @@ phase durations are optimised, so are the d_k: the polynomial that holds a
 given time then depends on the variables. As TOWR does, the spline evaluates
 the polynomial that holds t at the current durations and differentiates
 through the rest; with CasADi this is a sum of the candidate polynomials, each
-switched on by a comparison that AD treats as constant.
+switched on by a comparison that AD treats as constant. Such a sample also
+carries its Jacobian (:class:`PickCall`), which the formulation uses instead
+of differentiating the sample's graph.
 """
 
 from __future__ import annotations
 
 import functools
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import casadi as ca
@@ -21,7 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from roughwalk.trajopt.variables.hermite import hermite_point
 
-__all__ = ["NodeSpline", "NumericSpline", "sample_points"]
+__all__ = ["NodeSpline", "NumericSpline", "PickCall", "sample_points"]
 
 _EPS = 1e-9  # [s] tolerance of time comparisons against numeric junctions
 
@@ -39,31 +42,100 @@ def _hermite_function(dim: int) -> ca.Function:
 
 
 @functools.cache
-def _pick_function(dim: int, n: int, first_is_start: bool, last_is_end: bool) -> ca.Function:
+def _pick_function(dim: int, n: int) -> ca.Function:
     """Evaluate, at global time t, whichever of n candidate polynomials holds t.
 
-    Inputs: t, starts (n), durations (n), x0, v0, x1, v1 (dim × n). Candidate k
-    holds t when start_k < t ≤ start_k + d_k (the first polynomial of the
-    spline also holds t = 0, the last one any t past its start).
+    Inputs: t, lo (n), hi (n), q: the candidates' starts (n), durations (n),
+    then x0, v0, x1, v1 (dim × n each, column by column). Candidate k holds
+    t when lo_k < t ≤ hi_k (lo = start and hi = start + duration, except
+    that the spline's first polynomial also holds t = 0 and its last one any
+    t past its start). Outputs: position, velocity and acceleration (dim,
+    1), and ∂position/∂q (dim × len q).
+
+    The Jacobian is the Hermite polynomial's own (of the picked node
+    values, duration and start) times the candidates' on/off switches,
+    which AD treats as constant: one product per nonzero. CasADi's AD of
+    the samples' graphs took ~11 instructions a nonzero (271k for the
+    dynamics' and range of motion's points on the optimised-durations
+    walk). With one candidate (n = 1) lo and hi are not read: the
+    polynomial holds t for every admissible duration.
     """
     t = ca.SX.sym("t")
-    starts, durations = ca.SX.sym("starts", n), ca.SX.sym("durations", n)
-    x0, v0, x1, v1 = (ca.SX.sym(name, dim, n) for name in ("x0", "v0", "x1", "v1"))
+    lo, hi = ca.SX.sym("lo", n), ca.SX.sym("hi", n)
+    q = ca.SX.sym("q", n * (2 + 4 * dim))
+    starts, durations = q[:n], q[n : 2 * n]
+    nodes = ca.reshape(q[2 * n :], dim, 4 * n)
+    x0, v0, x1, v1 = (nodes[:, i * n : (i + 1) * n] for i in range(4))
+    if n == 1:
+        pos, vel, acc, jac_h = _hermite_with_jacobian(dim)(x0, v0, x1, v1, durations, starts, t)
+        # jac_h's columns (x0, v0, x1, v1, d, start) in q's order (start, d, x0, v0, x1, v1).
+        size = 4 * dim + 2
+        to_q = [*range(2, size), 1, 0]
+        order = ca.DM(ca.Sparsity.triplet(size, size, list(range(size)), to_q), 1)
+        return ca.Function("pick_polynomial", [t, lo, hi, q], [pos, vel, acc, jac_h @ order])
     picked: list[Any] = [0, 0, 0, 0, 0, 0]
+    switches = []
     any_active: Any = 0
     for k in range(n):
-        after = 1 if (k == 0 and first_is_start) else starts[k] < t
-        before = 1 if (k == n - 1 and last_is_end) else t <= starts[k] + durations[k]
-        active = ca.logic_and(after, before)
+        active = ca.logic_and(lo[k] < t, t <= hi[k])
         values = (x0[:, k], v0[:, k], x1[:, k], v1[:, k], durations[k], starts[k])
         for i, value in enumerate(values):
             picked[i] = picked[i] + ca.if_else(active, value, 0)
         any_active = any_active + active
+        switches.append(active)
     # Only an iterate far outside the duration bounds activates nothing; a
     # unit duration then keeps the expressions finite.
     duration = picked[4] + (1 - any_active)
-    out = hermite_point(picked[0], picked[1], picked[2], picked[3], duration, t - picked[5])
-    return ca.Function("pick_polynomial", [t, starts, durations, x0, v0, x1, v1], list(out))
+    pos, vel, acc, jac_h = _hermite_with_jacobian(dim)(
+        picked[0], picked[1], picked[2], picked[3], duration, picked[5], t
+    )
+    # ∂(x0, v0, x1, v1, d, start of the picked polynomial)/∂q: the switches.
+    rows, cols, entries = [], [], []
+    for k in range(n):
+        for role in range(4):
+            for i in range(dim):
+                rows.append(role * dim + i)
+                cols.append(2 * n + role * dim * n + k * dim + i)
+                entries.append(switches[k])
+        rows += [4 * dim, 4 * dim + 1]
+        cols += [n + k, k]
+        entries += [switches[k], switches[k]]
+    pick = ca.SX.triplet(rows, cols, ca.vertcat(*entries), 4 * dim + 2, int(q.numel()))
+    jac = jac_h @ pick
+    return ca.Function("pick_polynomial", [t, lo, hi, q], [pos, vel, acc, jac])
+
+
+@functools.cache
+def _hermite_with_jacobian(dim: int) -> ca.Function:
+    """hermite_point at t − start and ∂position/∂(x0, v0, x1, v1, d, start), written out.
+
+    With u = s/d: ∂p/∂x0 = 1 − 3u² + 2u³, ∂p/∂x1 = 3u² − 2u³, ∂p/∂v0 =
+    s(1 − u)², ∂p/∂v1 = s·u(u − 1), the same for every dimension;
+    ∂p/∂d = 6u²(1 − u)(x0 − x1)/d + 2u²(1 − u)v0 + u²(1 − 2u)v1 and
+    ∂p/∂start = −velocity. CasADi's AD of the polynomial adds 154
+    instructions for these 18 entries (dim 3), the formulas 62.
+    """
+    x0, v0, x1, v1 = (ca.SX.sym(n, dim) for n in ("x0", "v0", "x1", "v1"))
+    d, start, t = ca.SX.sym("d"), ca.SX.sym("start"), ca.SX.sym("t")
+    s = t - start
+    pos, vel, acc = hermite_point(x0, v0, x1, v1, d, s)
+    u = s / d
+    uu = u * u
+    rest = 1 - u
+    to_end = uu * (3 - 2 * u)
+    basis = (1 - to_end, s * rest * rest, to_end, s * u * (u - 1))
+    by_duration = 6 * uu * rest / d * (x0 - x1) + 2 * uu * rest * v0 + uu * (1 - 2 * u) * v1
+    rows, cols, entries = [], [], []
+    for i in range(dim):
+        for role, value in enumerate(basis):
+            rows.append(i)
+            cols.append(role * dim + i)
+            entries.append(value)
+        rows += [i, i]
+        cols += [4 * dim, 4 * dim + 1]
+        entries += [by_duration[i], -vel[i]]
+    jac = ca.SX.triplet(rows, cols, ca.vertcat(*entries), dim, 4 * dim + 2)
+    return ca.Function("hermite_jacobian", [x0, v0, x1, v1, d, start, t], [pos, vel, acc, jac])
 
 
 class NodeSpline:
@@ -107,6 +179,8 @@ class NodeSpline:
             if windows is None:
                 raise ValueError("symbolic durations need the polynomials' time windows")
             self.windows = [(float(a), float(b)) for a, b in windows]
+        self.picked: dict[int, tuple[PickCall, int]] = {}
+        """The position entries of picked samples (by element hash): their call and row."""
 
     @property
     def n_polys(self) -> int:
@@ -173,25 +247,62 @@ class NodeSpline:
     def point(self, t: float) -> tuple[ca.SX, ca.SX, ca.SX]:
         """Position, velocity, acceleration at global time t [s]."""
         ks = self.candidates(t)
-        if len(ks) == 1:
+        if self.fixed:
             k = ks[0]
             return self.poly_point(k, t - self.starts[k])
         # Select the active polynomial's node values and timing, then evaluate
         # one polynomial: far smaller expressions (and derivatives) than
         # switching between evaluated candidates.
-        pick = _pick_function(
-            int(self.positions[0].numel()), len(ks), ks[0] == 0, ks[-1] == self.n_polys - 1
+        dim, n, last = int(self.positions[0].numel()), len(ks), self.n_polys - 1
+        lo = [-np.inf if k == 0 or n == 1 else self.starts[k] for k in ks]
+        hi = [np.inf if k == last or n == 1 else self.ends[k] for k in ks]
+        index = self._pick_index(ks)
+        pos, vel, acc, jac = _pick_function(dim, n)(
+            t, ca.vertcat(*lo), ca.vertcat(*hi), self.basis[index]
         )
-        out = pick(
-            t,
-            ca.vertcat(*[self.starts[k] for k in ks]),
-            ca.vertcat(*[self.durations[k] for k in ks]),
-            ca.horzcat(*[self.positions[k] for k in ks]),
-            ca.horzcat(*[self.velocities[k] for k in ks]),
-            ca.horzcat(*[self.positions[k + 1] for k in ks]),
-            ca.horzcat(*[self.velocities[k + 1] for k in ks]),
+        call = PickCall(self, index, jac)
+        for i in range(dim):
+            self.picked[pos[i].element_hash()] = (call, i)
+        return pos, vel, acc
+
+    @functools.cached_property
+    def ends(self) -> list[Any]:
+        """Every polynomial's end [s]: start + duration, one expression for all samples."""
+        return [start + d for start, d in zip(self.starts, self.durations, strict=True)]
+
+    @functools.cached_property
+    def basis(self) -> ca.SX:
+        """Every polynomial's start and duration, then every node's value and derivative.
+
+        Affine in the variables: a picked sample's inputs are entries of it.
+        """
+        return ca.vertcat(
+            *self.starts, *self.durations, *map(ca.vec, self.positions), *self.velocities
         )
-        return out[0], out[1], out[2]
+
+    def _pick_index(self, ks: Sequence[int]) -> list[int]:
+        """Indices in :attr:`basis` of the inputs q of :func:`_pick_function` for ``ks``."""
+        dim, n_polys = int(self.positions[0].numel()), self.n_polys
+        nodes = 2 * n_polys
+        velocities = nodes + (n_polys + 1) * dim
+        index = list(ks) + [n_polys + k for k in ks]
+        for offset, shift in ((nodes, 0), (velocities, 0), (nodes, 1), (velocities, 1)):
+            index += [offset + (k + shift) * dim + i for k in ks for i in range(dim)]
+        return index
+
+
+@dataclass(frozen=True)
+class PickCall:
+    """A sample of ``spline`` that picks among candidate polynomials (:func:`_pick_function`).
+
+    Its inputs q are ``spline.basis[index]``, affine in the variables, so
+    ∂position/∂x = ``jacobian`` · ∂basis[index]/∂x with the second factor
+    constant (:func:`~roughwalk.trajopt.point_jacobian.points_jacobian`).
+    """
+
+    spline: NodeSpline
+    index: list[int]
+    jacobian: ca.SX
 
 
 def sample_points(
