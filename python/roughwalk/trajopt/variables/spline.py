@@ -16,7 +16,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import casadi as ca
 import numpy as np
@@ -73,34 +73,31 @@ def _pick_function(dim: int, n: int) -> ca.Function:
         to_q = [*range(2, size), 1, 0]
         order = ca.DM(ca.Sparsity.triplet(size, size, list(range(size)), to_q), 1)
         return ca.Function("pick_polynomial", [t, lo, hi, q], [pos, vel, acc, jac_h @ order])
-    picked: list[Any] = [0, 0, 0, 0, 0, 0]
-    switches = []
-    any_active: Any = 0
-    for k in range(n):
-        active = ca.logic_and(lo[k] < t, t <= hi[k])
-        values = (x0[:, k], v0[:, k], x1[:, k], v1[:, k], durations[k], starts[k])
-        for i, value in enumerate(values):
-            picked[i] = picked[i] + ca.if_else(active, value, 0)
-        any_active = any_active + active
-        switches.append(active)
+    # Matrix operations, not a loop over candidates: the same scalar
+    # operations (sums of one active candidate and exact zeros, so their
+    # order does not matter) in under half the CPU to build the function.
+    switches = ca.logic_and(lo < t, t <= hi).T
+    picked = [
+        ca.sum2(ca.if_else(ca.repmat(switches, int(m.size1()), 1), m, 0))
+        for m in (x0, v0, x1, v1, durations.T, starts.T)
+    ]
     # Only an iterate far outside the duration bounds activates nothing; a
     # unit duration then keeps the expressions finite.
-    duration = picked[4] + (1 - any_active)
+    duration = picked[4] + (1 - ca.sum2(switches))
     pos, vel, acc, jac_h = _hermite_with_jacobian(dim)(
         picked[0], picked[1], picked[2], picked[3], duration, picked[5], t
     )
     # ∂(x0, v0, x1, v1, d, start of the picked polynomial)/∂q: the switches.
-    rows, cols, entries = [], [], []
+    rows: list[int] = []
+    cols: list[int] = []
     for k in range(n):
         for role in range(4):
-            for i in range(dim):
-                rows.append(role * dim + i)
-                cols.append(2 * n + role * dim * n + k * dim + i)
-                entries.append(switches[k])
+            rows += [role * dim + i for i in range(dim)]
+            cols += [2 * n + role * dim * n + k * dim + i for i in range(dim)]
         rows += [4 * dim, 4 * dim + 1]
         cols += [n + k, k]
-        entries += [switches[k], switches[k]]
-    pick = ca.SX.triplet(rows, cols, ca.vertcat(*entries), 4 * dim + 2, int(q.numel()))
+    entries = ca.vec(ca.repmat(switches, 4 * dim + 2, 1))
+    pick = ca.SX.triplet(rows, cols, entries, 4 * dim + 2, int(q.numel()))
     jac = jac_h @ pick
     return ca.Function("pick_polynomial", [t, lo, hi, q], [pos, vel, acc, jac])
 
@@ -221,9 +218,13 @@ class NodeSpline:
         return list(zip(*(ca.horzsplit(o) for o in out), strict=True))
 
     def points(self, times: Sequence[float]) -> list[tuple[ca.SX, ca.SX, ca.SX]]:
-        """:meth:`point` at every time of ``times`` [s]; one mapped call if durations are fixed."""
+        """:meth:`point` at every time of ``times`` [s], from mapped calls.
+
+        Fixed durations: one call. Otherwise one call per number of
+        candidate polynomials (:meth:`picked_points`).
+        """
         if not self.fixed:
-            return [self.point(t) for t in times]
+            return self.picked_points(times)
         ks = [self.poly_at(t) for t in times]
         return self.poly_points(ks, [t - self.starts[k] for t, k in zip(times, ks, strict=True)])
 
@@ -264,6 +265,44 @@ class NodeSpline:
         for i in range(dim):
             self.picked[pos[i].element_hash()] = (call, i)
         return pos, vel, acc
+
+    def picked_points(self, times: Sequence[float]) -> list[tuple[ca.SX, ca.SX, ca.SX]]:
+        """:meth:`point` at every time of ``times`` [s], one mapped call per candidate count.
+
+        The same expressions as point by point (a mapped call inlines the
+        same operations), in a fraction of the calls: on the optimised-
+        durations walk 630 samples in 36 calls.
+        """
+        dim, last = int(self.positions[0].numel()), self.n_polys - 1
+        candidates = [self.candidates(t) for t in times]
+        groups: dict[int, list[int]] = {}
+        for j, ks in enumerate(candidates):
+            groups.setdefault(len(ks), []).append(j)
+        lo_all = ca.vertcat(-np.inf, *self.starts[1:])
+        hi_all = ca.vertcat(*self.ends[:last], np.inf)
+        out: list[tuple[ca.SX, ca.SX, ca.SX]] = [(ca.SX(), ca.SX(), ca.SX())] * len(times)
+        for n, members in groups.items():
+            m = len(members)
+            indices = [self._pick_index(candidates[j]) for j in members]
+            q = ca.reshape(self.basis[[i for index in indices for i in index]], len(indices[0]), m)
+            ks = [k for j in members for k in candidates[j]]
+            if n == 1:
+                lo, hi = ca.DM.ones(1, m) * -np.inf, ca.DM.ones(1, m) * np.inf
+            else:
+                lo, hi = ca.reshape(lo_all[ks], n, m), ca.reshape(hi_all[ks], n, m)
+            t = ca.DM([[float(times[j]) for j in members]])
+            pos, vel, acc, jac = _pick_function(dim, n).map(m)(t, lo, hi, q)
+            jacobians = ca.horzsplit(jac, len(indices[0]))
+            # elements() gives 1×1 SX (typed as SXElem): cheaper than indexing pos.
+            hashes = [e.element_hash() for e in cast(list[ca.SX], pos.elements())]
+            for c, (j, p, v, a) in enumerate(
+                zip(members, ca.horzsplit(pos), ca.horzsplit(vel), ca.horzsplit(acc), strict=True)
+            ):
+                call = PickCall(self, indices[c], jacobians[c])
+                for i in range(dim):
+                    self.picked[hashes[c * dim + i]] = (call, i)
+                out[j] = (p, v, a)
+        return out
 
     @functools.cached_property
     def ends(self) -> list[Any]:
@@ -310,17 +349,12 @@ def sample_points(
 ) -> list[list[tuple[ca.SX, ca.SX, ca.SX]]]:
     """Position, velocity, acceleration of every spline (outer list) at every time (inner).
 
-    With fixed durations every spline's points come from one mapped call
-    (:meth:`NodeSpline.points`). Otherwise they are made time by time, spline
-    by spline, in the order the constraints always made them: with
-    optimised durations that order steers IPOPT (the pallet climb took 89
-    iterations one way, 63 and 69 in others, though f, g and their
-    derivatives were equal at every point tried).
+    Every spline's points come from mapped calls (:meth:`NodeSpline.points`).
+    With optimised durations the order the points are made in has steered
+    IPOPT (the pallet climb took 89 iterations one way, 63 and 69 in others,
+    though f, g and their derivatives were equal at every point tried).
     """
-    if all(s.fixed for s in splines):
-        return [s.points(times) for s in splines]
-    by_time = [[s.point(t) for s in splines] for t in times]
-    return [[row[i] for row in by_time] for i in range(len(splines))]
+    return [s.points(times) for s in splines]
 
 
 class NumericSpline:
