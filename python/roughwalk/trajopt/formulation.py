@@ -115,8 +115,9 @@ def _call_jacobian(
     differentiating the rows. ∂u/∂z is constant when the points are
     ``affine`` in z (fixed durations): about a third of the CPU of the row
     blocks' Jacobians. Otherwise (optimised durations) it is
-    :func:`points_jacobian`, each distinct point differentiated once. None
-    when the calls mix functions or u was expected affine and is not.
+    :func:`points_jacobian`: the ``picked`` samples' own Jacobians, the
+    other points differentiated once each. None when the calls mix
+    functions or u was expected affine and is not.
     """
     calls = rows.calls or []
     if not calls or any(call.function is not calls[0].function for call in calls):
