@@ -74,7 +74,7 @@ def points_jacobian(
         blocks.append(_picked_jacobian([picked[hashes[j]] for j in from_picks], z))
     values = u[[distinct[j] for j in others]]
     if from_picks:
-        # What is left are the base's points: affine, differentiated at once.
+        # The rest (in TOWR's and Melon's rows the base's points, affine) in one call.
         blocks.append(ca.jacobian(values, z))
     else:
         m = len(others)
