@@ -18,6 +18,7 @@ from roughwalk.trajopt import (
     towr_config,
     valid_step_counts,
 )
+from roughwalk.trajopt.point_jacobian import points_jacobian
 from roughwalk.trajopt.task import Task, resolve
 from roughwalk.trajopt.variables import (
     NodeSpline,
@@ -171,6 +172,31 @@ def test_symbolic_durations_pick_the_right_polynomial() -> None:
         np.testing.assert_allclose(values[0:3, ok].T, p[ok], atol=1e-10)
         np.testing.assert_allclose(values[3:6, ok].T, v[ok], atol=1e-10)
         np.testing.assert_allclose(values[6:9, ok].T, a[ok], atol=1e-9)
+
+
+def test_picked_samples_jacobians_equal_casadis() -> None:
+    # A sample among candidate polynomials carries its own Jacobian (the
+    # Hermite derivatives written out, times the candidates' switches);
+    # through points_jacobian it must equal CasADi's AD of the sample, also
+    # at junctions, at t = 0 and at the end, and for one-candidate samples.
+    rng = np.random.default_rng(3)
+    x, v, d = ca.SX.sym("x", 3, 5), ca.SX.sym("v", 3, 5), ca.SX.sym("d", 3)
+    durations = [d[0], d[1], d[2], 1.6 - d[0] - d[1] - d[2]]
+    windows = [(0.0, 0.2), (0.05, 0.9), (0.2, 1.4), (0.4, 1.6)]
+    spline = NodeSpline(ca.horzsplit(x), ca.horzsplit(v), durations, windows)
+    times = [0.0, 0.05, 0.15, 0.3, 0.45, 0.6, 0.8, 1.0, 1.25, 1.6]
+    points = [spline.point(t)[0] for t in times]
+    assert any(len(spline.candidates(t)) == 1 for t in times)
+    assert any(len(spline.candidates(t)) > 2 for t in times)
+    u = ca.vertcat(*points)
+    z = ca.vertcat(ca.vec(x), ca.vec(v), d)
+    f = ca.Function("f", [z], [points_jacobian(u, z, spline.picked), ca.jacobian(u, z)])
+    for schedule in ([0.1, 0.5, 0.4], [0.15, 0.3, 0.6], [0.05, 0.25, 0.3]):
+        for _ in range(3):
+            values = np.concatenate([rng.normal(size=30), schedule])
+            ours, casadis = (np.asarray(j) for j in f(values))
+            np.testing.assert_allclose(ours, casadis, rtol=1e-12, atol=1e-12)
+            assert np.count_nonzero(ours) > 0
 
 
 def test_mapped_spline_points_equal_the_single_ones() -> None:

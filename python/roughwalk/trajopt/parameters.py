@@ -624,6 +624,14 @@ def towr_config(**changes: object) -> TrajoptConfig:
     to 81 in total) and block 1.5 m from 75 to 42 (383 to 214); the monotone
     barrier update, ``bound_relax_factor=0``, ``nlp_scaling_max_gradient=1000``,
     a 20-pair L-BFGS history and the quality-function oracle did not win on both.
+    The LOQO oracle (``mu_oracle=loqo``, session 11) is not kept either: with
+    optimised durations it took the block 1.0/1.4/1.5/1.6 m from 177 and 293
+    iterations (both stopped by the 40 s limit), 49 and 94 to 62, 61, 30 and
+    67, and the stairs 1.0/1.5 m from 40/27 to 24/14, but the stairs 0.9/1.1 m
+    from 16/185 to 25/329 (stopped by the limit) and the flat walk 1.3–1.7 m
+    from 11, 11, 12, 13, 13 to 12, 12, 11, 13, 15; with fixed durations the
+    block 1.0 m from 18 to 45, the gap walk from 55 to 155 and the bound from
+    28 to 71.
     """
     base = TrajoptConfig(
         constraints=TOWR_CONSTRAINTS,
