@@ -70,6 +70,7 @@ from roughwalk.learning import (
 from roughwalk.learning.filtering import cost_threshold, feasible_mask
 from roughwalk.learning.model_constraints import constraints_for_model
 from roughwalk.learning.model_costs import cost_changes, costs_for_model
+from roughwalk.learning.problem_spec import solver_settings
 from roughwalk.trajopt import HeuristicInitializer, TrajoptProblem
 
 RESULTS = Path(__file__).resolve().parent / "results"
@@ -380,8 +381,19 @@ def main() -> None:
         "--timing-tasks", type=int, default=12, help="tasks timed back to back (0: none)"
     )
     parser.add_argument("--json", type=Path, help="output JSON (default results/init_ENV.json)")
+    parser.add_argument(
+        "--set",
+        metavar="solver.NAME=VALUE",
+        action="append",
+        default=[],
+        help="a learned solve's restart setting (repeatable): solver.guess_fallback_after=N|none, "
+        "solver.dear_guess_restarts=N; the learned run folders record them",
+    )
     args = parser.parse_args()
     spec = spec_of_models(args.env, _models(args.models, args.env))
+    if any(not item.strip().startswith("solver.") for item in args.set):
+        raise SystemExit(f"bench init's --set takes solver.NAME=VALUE only, got {args.set}")
+    spec = replace(spec, solver=solver_settings(args.set))
     started = time.perf_counter()
     fig6 = figure_6(args, spec)
     times = timing(args, spec) if args.timing_tasks > 0 else {}
