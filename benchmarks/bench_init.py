@@ -35,7 +35,11 @@ refuses (:func:`~roughwalk.learning.problem_spec.task_refusal`: a start no
 solve can leave) are solved by no initialiser and listed with the reason;
 the figures count the other tasks.
 
-Run: ``roughwalk bench init [--env single_pallet] [--models DIR] [--tasks N]``.
+``--first-task K`` takes the held-out tasks K..K+N−1 of the test split
+instead of 0..N−1: a figure on tasks no setting was chosen by (the test
+split's stream is one sequence; each index's task depends only on it).
+
+Run: ``roughwalk bench init [--env single_pallet] [--models DIR] [--tasks N] [--first-task K]``.
 Writes ``benchmarks/results/init_ENV.json`` and ``init_ENV.png``.
 """
 
@@ -66,6 +70,7 @@ from roughwalk.learning import (
 from roughwalk.learning.filtering import cost_threshold, feasible_mask
 from roughwalk.learning.model_constraints import constraints_for_model
 from roughwalk.learning.model_costs import cost_changes, costs_for_model
+from roughwalk.learning.problem_spec import solver_settings
 from roughwalk.trajopt import HeuristicInitializer, TrajoptProblem
 
 RESULTS = Path(__file__).resolve().parent / "results"
@@ -151,13 +156,28 @@ def spec_of_models(env: str, models: list[tuple[str, LearnedModel]]) -> ProblemS
     return spec
 
 
+def held_out_indices(args: argparse.Namespace) -> list[int]:
+    """The test split's task indices the benchmark solves: ``--tasks`` from ``--first-task``."""
+    if args.first_task < 0 or args.tasks < 0:
+        raise SystemExit(f"--first-task and --tasks must be ≥ 0 ({args.first_task}, {args.tasks})")
+    return list(range(args.first_task, args.first_task + args.tasks))
+
+
 def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:
     """Held-out solves from every initialiser, summarised."""
     space = task_space(args.env)
+    indices = held_out_indices(args)
     base = args.experience / f"{space.name}_{spec.gait}{spec.steps}_test{_set_suffix(spec)}"
     runs: dict[str, Dataset] = {}
     runs["Heuristic"] = generate(
-        spec, space, args.tasks, base, split="test", max_iter=args.max_iter, progress=None
+        spec,
+        space,
+        args.tasks,
+        base,
+        split="test",
+        max_iter=args.max_iter,
+        progress=None,
+        indices=indices,
     )
     models = _models(args.models, args.env)
     g_max = None
@@ -177,6 +197,7 @@ def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:
             model=model,
             init=f"learned:{model.name}",
             progress=None,
+            indices=indices,
         )
     # The start of the tail of the heuristic's held-out costs, by today's
     # fence: a model header's g_max may come from an older fence.
@@ -191,9 +212,10 @@ def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:
     refused = {
         int(i): reason
         for i, reason in runs["Heuristic"].meta.get("refused", {}).items()
-        if int(i) < args.tasks
+        if int(i) in indices
     }
     return {
+        "task_indices": [indices[0], indices[-1] + 1] if indices else [],
         "refused": refused,
         "g_max": g_max,
         "heuristic_fence": fence,
@@ -209,7 +231,8 @@ def timing(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, dict[str, f
     from roughwalk.learning.initializer import LearnedInitializer
 
     space = task_space(args.env)
-    tasks = space.sample(args.timing_tasks, split="test")
+    first = args.first_task
+    tasks = [space.task(i, split="test") for i in range(first, first + args.timing_tasks)]
     problem = build_problem(spec)
     initializers: dict[str, Any] = {"Heuristic": HeuristicInitializer}
     for name, model in _models(args.models, args.env):
@@ -259,7 +282,8 @@ def table_1(args: argparse.Namespace, spec: ProblemSpec) -> list[dict[str, Any]]
     from roughwalk.trajopt.task import resolve
 
     space = task_space(args.env)
-    tasks = space.sample(args.table_tasks, split="test")
+    first = args.first_task
+    tasks = [space.task(i, split="test") for i in range(first, first + args.table_tasks)]
     rows = []
     for label, optimise_durations, fix_feet in (
         ("all variables optimised", True, False),
@@ -339,6 +363,13 @@ def main() -> None:
         "--models", type=Path, help="folder of learned_init_K.npz (default shipped)"
     )
     parser.add_argument("--tasks", type=int, default=50, help="held-out tasks (default 50)")
+    parser.add_argument(
+        "--first-task",
+        type=int,
+        default=0,
+        help="index of the first held-out task in the test split (default 0): "
+        "--tasks 200 --first-task 200 solves tasks 200..399",
+    )
     parser.add_argument("--max-iter", type=int, default=100, help="iteration limit (default 100)")
     parser.add_argument("--experience", type=Path, default=Path(".experience"), help="run folders")
     parser.add_argument("--table-tasks", type=int, default=3, help="tasks per Table I row")
@@ -350,8 +381,19 @@ def main() -> None:
         "--timing-tasks", type=int, default=12, help="tasks timed back to back (0: none)"
     )
     parser.add_argument("--json", type=Path, help="output JSON (default results/init_ENV.json)")
+    parser.add_argument(
+        "--set",
+        metavar="solver.NAME=VALUE",
+        action="append",
+        default=[],
+        help="a learned solve's restart setting (repeatable): solver.guess_fallback_after=N|none, "
+        "solver.dear_guess_restarts=N; the learned run folders record them",
+    )
     args = parser.parse_args()
     spec = spec_of_models(args.env, _models(args.models, args.env))
+    if any(not item.strip().startswith("solver.") for item in args.set):
+        raise SystemExit(f"bench init's --set takes solver.NAME=VALUE only, got {args.set}")
+    spec = replace(spec, solver=solver_settings(args.set))
     started = time.perf_counter()
     fig6 = figure_6(args, spec)
     times = timing(args, spec) if args.timing_tasks > 0 else {}
@@ -361,7 +403,8 @@ def main() -> None:
     learned = [k for k in inits if k != "Heuristic"]
     best = learned[-1] if learned else None
     print(
-        f"Figure 6, {args.env}: {args.tasks} held-out tasks, g_max {fig6['g_max']:.4g} "
+        f"Figure 6, {args.env}: {args.tasks} held-out tasks "
+        f"({args.first_task}..{args.first_task + args.tasks - 1}), g_max {fig6['g_max']:.4g} "
         f"(model), fence {fig6['heuristic_fence'] or math.nan:.4g} (heuristic's held-out costs)"
     )
     for index, reason in sorted(fig6["refused"].items()):
@@ -450,8 +493,12 @@ def main() -> None:
 
 
 def _null_for_nan(value: Any) -> Any:
-    """``value`` with every NaN float replaced by None (JSON has no NaN; e.g. no timed tasks)."""
-    if isinstance(value, float) and math.isnan(value):
+    """``value`` with every NaN or infinite float replaced by None (JSON has neither).
+
+    NaN: e.g. no timed tasks; infinity: g_max without a model when no
+    heuristic solve is feasible.
+    """
+    if isinstance(value, float) and not math.isfinite(value):
         return None
     if isinstance(value, dict):
         return {k: _null_for_nan(v) for k, v in value.items()}

@@ -43,7 +43,9 @@ def _problem_args(p: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         help="a cost weight that differs from melon_config's, as for roughwalk optimize "
-        "(repeatable, dotted names: costs.force_between_nodes_penalty=10, costs.force.weight=0.1)",
+        "(repeatable, dotted names: costs.force_between_nodes_penalty=10, costs.force.weight=0.1), "
+        "or a learned solve's restart setting (solver.guess_fallback_after=40, "
+        "solver.dear_guess_restarts=0: a learned run folder records them)",
     )
 
 
@@ -119,6 +121,14 @@ def register(sub: Any) -> None:
     it.add_argument("--out", type=Path, required=True, help="folder for rounds and models")
     it.add_argument("--g-max", type=float, help="cost threshold (default: start of the tail)")
     it.add_argument("--seed", type=int, default=0, help="training seed")
+    it.add_argument(
+        "--set",
+        metavar="solver.NAME=VALUE",
+        action="append",
+        default=[],
+        help="a re-solve's restart setting (solver.guess_fallback_after=40, "
+        "solver.dear_guess_restarts=0): each round's folder records them",
+    )
     _executor_args(it)
     it.set_defaults(func=cmd_iterate)
     p.set_defaults(func=lambda args: p.print_help() or 2)
@@ -144,7 +154,12 @@ def cmd_generate(args: argparse.Namespace) -> int:
     """Solve ``--tasks`` sampled tasks into a resumable run folder."""
     from roughwalk.learning.executors import make_executor
     from roughwalk.learning.experience import N_HEURISTIC, generate
-    from roughwalk.learning.problem_spec import ProblemSpec, constraint_set, cost_weights
+    from roughwalk.learning.problem_spec import (
+        ProblemSpec,
+        constraint_set,
+        cost_weights,
+        solver_settings,
+    )
 
     space = _space(args)
     spec = ProblemSpec(
@@ -156,6 +171,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         args.optimize_durations,
         None if args.constraints is None else constraint_set(args.constraints),
         cost_weights(args.set),
+        solver_settings(args.set),
     )
     out = args.out or DEFAULT_ROOT / f"{space.name}_{args.gait}{args.steps}_{args.split}"
     jitter = _jitter(args.jitter, args.init != "heuristic")
@@ -239,9 +255,13 @@ def cmd_train(args: argparse.Namespace) -> int:
 
 def cmd_iterate(args: argparse.Namespace) -> int:
     """LearnedInit-1..K from a heuristic run."""
+    from roughwalk.errors import InvalidArgumentError
     from roughwalk.learning.executors import make_executor
     from roughwalk.learning.iterate import learned_init_rounds
+    from roughwalk.learning.problem_spec import solver_settings
 
+    if any(not item.strip().startswith("solver.") for item in args.set):
+        raise InvalidArgumentError(f"init iterate's --set takes solver.NAME=VALUE, got {args.set}")
     executor = make_executor(args.executor, workers=args.workers, address=args.address)
     rounds = learned_init_rounds(
         args.run,
@@ -253,6 +273,7 @@ def cmd_iterate(args: argparse.Namespace) -> int:
         seed=args.seed,
         executor=executor,
         progress=sys.stderr,
+        solver=solver_settings(args.set),
     )
     for r in rounds:
         print(r.summary())

@@ -28,8 +28,10 @@ from roughwalk.learning.dataset import COLUMNS, Dataset
 from roughwalk.learning.executors import Executor, LocalExecutor
 from roughwalk.learning.model_costs import cost_changes
 from roughwalk.learning.problem_spec import (
+    UNRECORDED_SOLVE_SETTINGS,
     ProblemSpec,
     build_problem,
+    solve_settings,
     task_refusal,
     variable_layout,
 )
@@ -236,10 +238,18 @@ class ExperienceRun:
         What the run solves: "problem", "task_space", "split", "seed",
         "init", "max_iter" (and "layout", added on the first solve). A folder
         made for other settings is refused, naming the first that differs.
+    unrecorded:
+        What a folder that does not record a key of ``meta`` was made with
+        (a record added later: "solver"); a key missing here too refuses it.
 
     """
 
-    def __init__(self, folder: str | Path, meta: dict[str, Any]) -> None:
+    def __init__(
+        self,
+        folder: str | Path,
+        meta: dict[str, Any],
+        unrecorded: dict[str, Any] | None = None,
+    ) -> None:
         self.folder = Path(folder)
         self.solves = self.folder / "solves"
         self.solves.mkdir(parents=True, exist_ok=True)
@@ -247,7 +257,14 @@ class ExperienceRun:
         meta = json.loads(json.dumps(meta))  # tuples as JSON lists, as read back
         if meta_path.is_file():
             old = json.loads(meta_path.read_text())
+            unrecorded = json.loads(json.dumps(unrecorded or {}))
             for key, value in meta.items():
+                if key not in old and key in unrecorded:
+                    _check_settings(self.folder, key, unrecorded[key], value, recorded=False)
+                    continue
+                if key in unrecorded and isinstance(old[key], dict):
+                    _check_settings(self.folder, key, old[key], value, recorded=True)
+                    continue
                 if key not in old:
                     # An older run that did not record this cannot prove it matches
                     # (e.g. solved before the constraint set was recorded).
@@ -301,6 +318,28 @@ class ExperienceRun:
         data = Dataset.from_rows(self.rows(indices), self.meta)
         data.save(self.folder / "dataset.npz")
         return data
+
+
+def _check_settings(
+    folder: Path, key: str, old: dict[str, Any], new: dict[str, Any], *, recorded: bool
+) -> None:
+    """Refuse a folder whose settings ``key`` (a dict) differ from ``new``, naming the first."""
+    for name in {**old, **new}:
+        if name in old and old.get(name) == new.get(name):
+            continue
+        was = _setting(old.get(name))
+        made = "made with" if recorded else "made before run folders recorded it, so with"
+        raise ConfigError(
+            f"{folder} holds solves {made} {key}.{name}={was}; this run has "
+            f"{key}.{name}={_setting(new.get(name))}, and resuming would mix solves of both "
+            f"settings in one dataset: use a fresh folder, or --set {key}.{name}={was} "
+            "to finish the run as it was made"
+        )
+
+
+def _setting(value: Any) -> str:
+    """A setting's value as ``--set`` spells it."""
+    return "none" if value is None else str(value)
 
 
 def _progress(done: int, total: int, new: int, started: float, out: TextIO) -> None:
@@ -399,7 +438,10 @@ def generate(
             "max_iter": max_iter,
             # Only when given: runs made before jitter existed resume as before.
             **({} if jitter is None else {"jitter": [*map(float, jitter), int(jitter_seed)]}),
+            # How a learned solve restarts (a heuristic solve uses none of it).
+            **({} if model is None else {"solver": solve_settings(spec)}),
         },
+        unrecorded={"solver": UNRECORDED_SOLVE_SETTINGS},
     )
     wanted = list(range(n_tasks)) if indices is None else sorted(set(indices))
     # Tasks the problem refuses (a start no solve can leave) are not solved:

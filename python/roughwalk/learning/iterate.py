@@ -13,7 +13,7 @@ else one global g_max.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -73,6 +73,7 @@ def learned_init_rounds(
     executor: Executor | None = None,
     progress: Any = None,
     resolve_last: bool = False,
+    solver: tuple[tuple[str, int | None], ...] | None = None,
 ) -> list[RoundReport]:
     """Train LearnedInit-1..``rounds`` from the heuristic run folder ``run``; write them in ``out``.
 
@@ -80,13 +81,14 @@ def learned_init_rounds(
     to ``out/round_K/`` (resumable like any run). ``n_tasks`` limits the
     re-solved tasks to the first N of the run (every round trains on the
     latest solution of every task then, re-solved or not); the last round's
-    model is re-solved only with ``resolve_last``.
+    model is re-solved only with ``resolve_last``. ``solver``: the re-solves'
+    restart settings that differ from the defaults (:attr:`ProblemSpec.solver`).
     """
     folder = Path(out)
     data = read_run(run)
     task_cost = fit_task_cost(data) if g_max is None else None
     threshold = None if task_cost is not None else filter_good(data, g_max).g_max
-    spec = ProblemSpec.from_dict(data.meta["problem"])
+    spec = replace(ProblemSpec.from_dict(data.meta["problem"]), solver=solver)
     space = TaskSpace.from_dict(data.meta["task_space"])
     indices = [int(i) for i in data["index"] if n_tasks is None or i < n_tasks]
     reports: list[RoundReport] = []

@@ -41,6 +41,10 @@ __all__ = [
     "constraint_set",
     "task_refusal",
     "cost_weights",
+    "LEARNED_SOLVE_SETTINGS",
+    "UNRECORDED_SOLVE_SETTINGS",
+    "solve_settings",
+    "solver_settings",
     "build_problem",
     "variable_layout",
     "variable_categories",
@@ -52,6 +56,28 @@ CONSTRAINT_SETS: dict[str, tuple[str, ...]] = {
     "towr": TOWR_CONSTRAINTS,
 }
 """Named constraint sets (``roughwalk init generate --constraints NAME``)."""
+
+LEARNED_SOLVE_SETTINGS = ("guess_fallback_after", "dear_guess_restarts")
+"""The ``solver`` fields that change where a solve from a learned guess ends.
+
+The restarts from a learned guess: the network's guess after a stuck
+library pick, further library candidates after a dear converged one. A
+learned run folder records them (:func:`solve_settings`), so that a folder
+is not resumed under others; a heuristic solve uses neither.
+"""
+
+UNRECORDED_SOLVE_SETTINGS: dict[str, int | None] = {
+    "guess_fallback_after": 40,
+    "dear_guess_restarts": 0,
+}
+"""What a learned run folder that records no ``solver`` settings was solved with.
+
+Folders from before the record (session 10): ``guess_fallback_after`` was
+40 from its introduction (340b041) until raised to 50 (1ebd6dc), and
+``dear_guess_restarts`` did not exist (34ed209 added it). Folders from
+before 340b041 had no fallback at all; they cannot be told apart and count
+as these too.
+"""
 
 _problems: dict[ProblemSpec, TrajoptProblem] = {}
 _grounds: dict[ProblemSpec, tuple[SingleRigidBody, TerrainModel]] = {}
@@ -83,6 +109,12 @@ class ProblemSpec:
         Cost weights that differ from ``melon_config``'s, as (dotted name,
         value) pairs (("force_between_nodes_penalty", 10.0),); None: the
         default weights (left out of :meth:`to_dict` then, as ``constraints``).
+    solver:
+        :data:`LEARNED_SOLVE_SETTINGS` that differ from ``melon_config``'s, as
+        (name, value) pairs (("guess_fallback_after", 40),); None: the
+        defaults. Never in :meth:`to_dict`: they change how a solve from a
+        learned guess restarts, not the NLP a model fits, and a run records
+        all of them, defaults too, under "solver" (:func:`solve_settings`).
 
     """
 
@@ -94,6 +126,7 @@ class ProblemSpec:
     optimize_durations: bool = False
     constraints: tuple[str, ...] | None = None
     costs: tuple[tuple[str, float], ...] | None = None
+    solver: tuple[tuple[str, int | None], ...] | None = None
 
     def config(self) -> TrajoptConfig:
         """Melon et al.'s configuration for this problem."""
@@ -109,11 +142,14 @@ class ProblemSpec:
         )
         if self.costs:
             config = override(config, {f"costs.{k}": v for k, v in self.costs})
+        if self.solver:
+            config = override(config, {f"solver.{k}": v for k, v in self.solver})
         return config
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data for JSON (``constraints`` and ``costs`` only when not the defaults)."""
         data = asdict(self)
+        del data["solver"]
         if self.constraints is None:
             del data["constraints"]
         else:
@@ -169,15 +205,18 @@ def cost_weights(items: Iterable[str]) -> tuple[tuple[str, float], ...] | None:
     Spelled and parsed as ``roughwalk optimize --set`` (:func:`~roughwalk.config.parse_set`,
     dotted names such as ``costs.force.weight``); each weight is checked
     against :func:`~roughwalk.trajopt.melon_config`'s, and a bad name or value
-    raises :class:`~roughwalk.errors.ConfigError` naming the item. Only the
-    weights that differ from the defaults are kept (None: none), as the run
-    records them, so that an explicit default value makes the same problem.
+    raises :class:`~roughwalk.errors.ConfigError` naming the item (``solver.``
+    items are :func:`solver_settings`'s). Only the weights that differ from
+    the defaults are kept (None: none), as the run records them, so that an
+    explicit default value makes the same problem.
     """
     from roughwalk.learning.model_costs import cost_changes, cost_leaves
 
     weights = melon_config().costs
     known = cost_leaves(weights)
     for key, value in parse_set(items).items():
+        if key.startswith("solver."):
+            continue  # solver_settings's
         name = key.removeprefix("costs.")
         if name == key or name not in known:
             raise ConfigError(
@@ -190,6 +229,43 @@ def cost_weights(items: Iterable[str]) -> tuple[tuple[str, float], ...] | None:
             raise ConfigError(f"--set {key}={value}: {e}") from None
     changes = cost_changes(weights)
     return tuple(sorted(changes.items())) if changes else None
+
+
+def solver_settings(items: Iterable[str]) -> tuple[tuple[str, int | None], ...] | None:
+    """``solver.NAME=VALUE`` items of ``--set`` as :attr:`ProblemSpec.solver`.
+
+    NAME is one of :data:`LEARNED_SOLVE_SETTINGS` ("none" for None); items
+    of other sections (``costs.``) are left to :func:`cost_weights`. Only the
+    values that differ from :func:`~roughwalk.trajopt.melon_config`'s are kept
+    (None: none), so that an explicit default makes the same problem.
+    """
+    default = melon_config().solver
+    solver = default
+    for key, value in parse_set(items).items():
+        name = key.removeprefix("solver.")
+        if name == key:
+            continue
+        if name not in LEARNED_SOLVE_SETTINGS:
+            raise ConfigError(
+                f"--set {key}={value}: not a learned-solve setting; give solver.NAME=VALUE "
+                f"with NAME among {', '.join(LEARNED_SOLVE_SETTINGS)}"
+            )
+        try:
+            solver = override(solver, {name: value})
+        except ConfigError as e:
+            raise ConfigError(f"--set {key}={value}: {e}") from None
+    changes = tuple(
+        (name, getattr(solver, name))
+        for name in LEARNED_SOLVE_SETTINGS
+        if getattr(solver, name) != getattr(default, name)
+    )
+    return changes or None
+
+
+def solve_settings(spec: ProblemSpec) -> dict[str, int | None]:
+    """:data:`LEARNED_SOLVE_SETTINGS` as ``spec``'s solves use them (a run's "solver" record)."""
+    solver = spec.config().solver
+    return {name: getattr(solver, name) for name in LEARNED_SOLVE_SETTINGS}
 
 
 def _ground(spec: ProblemSpec) -> tuple[SingleRigidBody, TerrainModel]:
