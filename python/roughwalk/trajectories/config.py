@@ -224,6 +224,11 @@ class TimingConfig:
         4.23. Flat-ground swings do not change: the 1 N·s side push
         (``roughwalk bench push_recovery --direction 90`` / ``-90``)
         survives 16 and 15 of 17 with both, at the same push times.
+    measured_speed:
+        Fraction (0 < · ≤ 1) of its velocity limit that each phase's
+        fastest joint reaches on the initial trajectory: the nominal timing
+        is shortened until it does (never lengthened: that is the re-timing
+        on a broken limit, and restarts). 0 keeps the nominal timing.
     max_step_s:
         Longest a step may be made by restarts [s].
     settle_s:
@@ -282,6 +287,7 @@ class TimingConfig:
     min_hold_s: float = 0.06
     first_shift_s: float = 0.2
     min_swing_s: float = 0.3
+    measured_speed: float = 0.0
     max_step_s: float = 4.0
     settle_s: float = 0.8
     swing_trunk: str = "moving"
@@ -302,6 +308,8 @@ class TimingConfig:
             v = getattr(self, name)
             if not (math.isfinite(v) and v >= 1):
                 raise ConfigError(f"timing.{name} must be ≥ 1, got {v}")
+        if not (math.isfinite(self.measured_speed) and 0 <= self.measured_speed <= 1):
+            raise ConfigError(f"timing.measured_speed must be in [0, 1], got {self.measured_speed}")
         if self.swing_trunk not in ("still", "landing", "shorter", "moving"):
             raise ConfigError(
                 "timing.swing_trunk must be 'still', 'landing', 'shorter' or 'moving', "
