@@ -10,6 +10,9 @@ from roughwalk.trajectories import straight_crawl_plan
 from roughwalk.trajectories.generator import FootstepTrajectoryGenerator
 
 TARGET = 0.9
+# The "even" swing law: with the "joint" law the fitted 9 cm crawl's last step
+# (RF) ends invalid, a supporting foot out of reach at a fixed sample.
+SETTINGS = {"timing.min_swing_s": 0.2, "swing.time_law": "even", "swing.ramp_fraction": 0.2}
 
 
 @pytest.fixture(scope="module")
@@ -24,7 +27,7 @@ def crawl() -> tuple[rw.Robot, rw.Terrain, object, dict]:
 
 def generated(crawl, **settings) -> tuple[FootstepTrajectoryGenerator, list]:
     robot, terrain, sdf, plan = crawl
-    config = rw.trajectories.trajectory_config(**{"timing.min_swing_s": 0.2, **settings})
+    config = rw.trajectories.trajectory_config(**{**SETTINGS, **settings})
     gen = FootstepTrajectoryGenerator(robot, terrain, sdf=sdf, config=config)
     return gen, list(gen.iter_steps(gen.prepare(plan)))
 
@@ -69,9 +72,7 @@ def test_measured_timing_walks_the_crawl_faster_than_the_nominal_estimate(crawl)
 
 def test_the_preview_plans_with_the_fitted_timings_of_the_steps_ahead(crawl) -> None:
     robot, terrain, sdf, plan = crawl
-    config = rw.trajectories.trajectory_config(
-        **{"timing.min_swing_s": 0.2, "timing.measured_speed": TARGET}
-    )
+    config = rw.trajectories.trajectory_config(**{**SETTINGS, "timing.measured_speed": TARGET})
     gen = FootstepTrajectoryGenerator(robot, terrain, sdf=sdf, config=config)
     prepared = gen.prepare(plan)
     assert prepared.nominal is not None

@@ -1,6 +1,8 @@
 """From footsteps to full-body trajectories, one footstep at a time (Zucker 2011, §5).
 
-For each footstep: estimate its timing from the joint velocity limits, build
+For each footstep: estimate its timing from the joint velocity limits (with
+``timing.measured_speed``, then shorten it until the initial trajectory's
+fastest joints reach that share of their limits), build
 the initial trajectory (ZMP preview over a window of the next footsteps,
 certificate splines, swing spline, IK) and, where its swing already outruns
 a joint's velocity limit, lengthen it by that excess at once; run CHOMP as
