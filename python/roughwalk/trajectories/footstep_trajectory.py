@@ -32,6 +32,7 @@ __all__ = [
     "control_times",
     "resample_footstep",
     "swing_leg_angles",
+    "phase_speed_ratios",
     "swing_speed_ratio",
 ]
 
@@ -152,6 +153,23 @@ def swing_speed_ratio(state: FootstepState, wb: WholeBody, rate_hz: float) -> fl
     q = swing_leg_angles(state, wb, time[airborne])
     qd = np.gradient(q, dt, axis=0, edge_order=2)
     return float(np.max(np.abs(qd) / wb.velocity_limit[state.step.leg]))
+
+
+def phase_speed_ratios(state: FootstepState, wb: WholeBody, rate_hz: float) -> tuple[float, float]:
+    """Peak |q̇| / velocity limit over every joint in the shift and in the swing: (shift, swing).
+
+    The supporting legs' rates are differences of the state's samples (their
+    angles follow the trunk by IK); the swing leg's in the air is
+    :func:`swing_speed_ratio`.
+    """
+    q = np.asarray(state.q, dtype=float).reshape(state.n_samples, 4, 3)
+    limit = wb.velocity_limit.reshape(4, 3)
+    rate = np.abs(np.diff(q, axis=0)) / state.dt / limit
+    lift, touch = state.lift_off, state.touchdown
+    shift = float(rate[:lift].max()) if lift > 0 else 0.0
+    others = np.arange(4) != state.step.leg
+    swing = float(rate[lift:touch][:, others].max()) if touch > lift else 0.0
+    return shift, max(swing, swing_speed_ratio(state, wb, rate_hz))
 
 
 def resample_footstep(
