@@ -278,6 +278,7 @@ def run_job(job: Job) -> dict[str, Any]:
         first_leg_contact=outcome.first_leg_contact,
         implied_torque=outcome.implied_torque,
         max_implied_torque_nm=(outcome.implied_torque or {}).get("max_nm"),
+        friction_demand=outcome.friction_demand,
         time_s=time.perf_counter() - started,
         cpu_s=time.process_time() - started_cpu,
     )
@@ -327,6 +328,11 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
         torque = [
             r["max_implied_torque_nm"] for r in rs if r.get("max_implied_torque_nm") is not None
         ]
+        beyond = [
+            r["friction_demand"]["over_fraction"]
+            for r in rs
+            if r.get("friction_demand") is not None
+        ]
         out.append(
             {
                 "env": env,
@@ -341,6 +347,7 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 / len(rs),
                 "median_pyramid_violation_n": float(np.median(pyramid)) if pyramid else None,
                 "median_max_implied_torque_nm": float(np.median(torque)) if torque else None,
+                "median_beyond_friction_share": float(np.median(beyond)) if beyond else None,
             }
         )
     return out
@@ -586,6 +593,7 @@ def _progress(row: dict[str, Any]) -> str:
         f"{'success' if row.get('success') else 'failure'}: {row.get('reason', '')}"
         f"{_leg_contact(row.get('first_leg_contact'))}"
         f"{_implied_torque(row.get('implied_torque'))}"
+        f"{_friction_demand(row.get('friction_demand'))}"
         f" ({row.get('cpu_s', 0.0):.0f} s CPU)"
     )
 
@@ -596,6 +604,16 @@ def _implied_torque(implied: dict[str, Any] | None) -> str:
         return ""
     where = f"{implied['joint']} at {implied['time_s']:.2f} s"
     return f"; plan asks {implied['max_nm']:.0f} N·m of {where}"
+
+
+def _friction_demand(demand: dict[str, Any] | None) -> str:
+    """'; base motion beyond μ 0.6 on 14 % of stance' (the plan's net force outside friction)."""
+    if not demand:
+        return ""
+    return (
+        f"; base motion beyond μ {demand['friction']:.2g} on "
+        f"{100 * demand['over_fraction']:.0f} % of stance"
+    )
 
 
 def _leg_contact(touch: dict[str, Any] | None) -> str:

@@ -120,6 +120,11 @@ class TrackingOutcome:
         ``time_s``, ``joint``, ``limit_nm``, ``over_limit_fraction``,
         ``unreachable_fraction``); None when not computed (a reference
         executed without its plan, or a robot without analytic IK).
+    friction_demand:
+        How much friction the plan's base motion needs against the
+        controller's μ (:class:`~roughwalk.trajopt.FrictionDemand` as a dict:
+        ``friction``, ``over_fraction``, ``max_ratio``, ``time_s``): beyond
+        μ no force distribution realises it; None when not computed.
     log:
         Per-tick arrays (not in :meth:`to_dict`).
     """
@@ -143,6 +148,7 @@ class TrackingOutcome:
     mean_tick_cpu_ms: float = 0.0
     first_leg_contact: dict[str, Any] | None = None
     implied_torque: dict[str, Any] | None = None
+    friction_demand: dict[str, Any] | None = None
     log: TrackingLog | None = field(default=None, repr=False)
     video: str | None = None
 

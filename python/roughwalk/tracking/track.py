@@ -84,7 +84,14 @@ def track(
     terrain_obj = _named(terrain, result.terrain, "terrain", load_terrain)
     reference = Reference.from_result(result)
     outcome = execute_reference(reference, robot_obj, terrain_obj, config, video=video, push=push)
-    return replace(outcome, implied_torque=_implied_torque(result, robot_obj))
+    from roughwalk.trajopt import friction_demand
+
+    mu = (config if config is not None else TrackingConfig()).friction
+    return replace(
+        outcome,
+        implied_torque=_implied_torque(result, robot_obj),
+        friction_demand=friction_demand(result, mu).to_dict(),
+    )
 
 
 def _implied_torque(result: TrajoptResult, robot: Robot) -> dict[str, Any] | None:

@@ -8,6 +8,7 @@ rate. :class:`TrajoptProblem` builds an NLP once and solves many tasks.
 """
 
 from roughwalk.trajopt.formulation import Formulation
+from roughwalk.trajopt.friction_demand import FrictionDemand, friction_demand, required_friction
 from roughwalk.trajopt.gaits import GAIT_NAMES, ContactSchedule, make_gait, valid_step_counts
 from roughwalk.trajopt.implied_torques import ImpliedTorques, implied_torques, plan_joint_torques
 from roughwalk.trajopt.initializers import (
@@ -74,5 +75,8 @@ __all__ = [
     "clear_cache",
     "ImpliedTorques",
     "implied_torques",
+    "FrictionDemand",
+    "friction_demand",
+    "required_friction",
     "plan_joint_torques",
 ]
