@@ -409,11 +409,21 @@ def _joined(first: SolveOutcome, second: SolveOutcome, nlp: Formulation) -> Solv
 def _cheaper(kept: SolveOutcome, other: SolveOutcome) -> SolveOutcome:
     """The cheaper converged outcome of a converged ``kept`` and a further start's; both paid.
 
-    Iterations and time are the sum of both solves; the history runs on.
+    Iterations and time are the sum of both solves; the history runs on as
+    :func:`_joined`'s does: numbers and times after ``kept``'s, and each
+    entry's ``solve`` one after the last solve's (0 for an untagged first).
     """
     chosen = other if other.status.solved and other.objective < kept.objective else kept
-    history = list(kept.history) + [
-        {**h, "iteration": h.get("iteration", 0) + kept.iterations} for h in other.history
+    first = [h if "solve" in h else {**h, "solve": 0.0} for h in kept.history]
+    number = max((h["solve"] for h in first), default=-1.0) + 1.0
+    history = first + [
+        {
+            **h,
+            "iteration": h.get("iteration", 0) + kept.iterations,
+            "elapsed_s": h.get("elapsed_s", 0.0) + kept.solve_time_s,
+            "solve": number,
+        }
+        for h in other.history
     ]
     return replace(
         chosen,
