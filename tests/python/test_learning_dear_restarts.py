@@ -74,6 +74,10 @@ def test_farthest_picks_the_row_farthest_from_what_was_tried() -> None:
     assert farthest(pool, [pool[0], pool[2]], scale) == 1  # a tie at 0.71: the first
     assert farthest(pool, list(pool), scale) is None  # every row tried
     assert farthest(pool, [], scale) == 0
+    # A solve that ended on NaN (IPOPT's invalid number) hides no row.
+    diverged = np.array([np.nan, 0.0])
+    assert farthest(pool, [pool[0], diverged], scale) == 2
+    assert farthest(pool, [diverged], scale) == 0
 
 
 def test_dear_guess_restarts_must_not_be_negative() -> None:
