@@ -528,15 +528,21 @@ def jittered(
 
 
 def read_run(folder: str | Path) -> Dataset:
-    """The finished solves of a run folder (even one still running), without writing anything."""
+    """The finished solves of a run folder (even one still running), without writing anything.
+
+    Tasks the run records as refused are left out, as :func:`generate`'s
+    dataset leaves them: a folder solved before the refusal existed holds
+    their (infeasible) solves.
+    """
     path = Path(folder)
     meta_path = path / "run.json"
     if not meta_path.is_file():
         raise ConfigError(f"{path} is not an experience run (no run.json)")
     meta = json.loads(meta_path.read_text())
+    refused = {int(i) for i in meta.get("refused", {})}
     rows = []
     for item in sorted((path / "solves").glob("*.npz")):
-        if not item.stem.isdigit():
+        if not item.stem.isdigit() or int(item.stem) in refused:
             continue
         with np.load(item, allow_pickle=False) as data:
             rows.append(_row(data))
