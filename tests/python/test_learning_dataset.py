@@ -273,3 +273,18 @@ def test_reading_a_run_solved_before_the_refusal_leaves_the_refused_out(
     kept = sorted(set(range(6)) - set(refused))
     assert data["index"].tolist() == kept
     assert read_run(tmp_path / "run")["index"].tolist() == kept
+
+
+def test_a_task_no_longer_refused_is_solved_and_read_again(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A refusal recorded by an earlier check that no longer refuses the task
+    # must not keep its new solve out of read_run.
+    with monkeypatch.context() as m:
+        m.setattr(experience, "task_refusal", lambda spec, task: "refused by an older check")
+        generate(SPEC, SPACE, 2, tmp_path / "run", max_iter=1, progress=None)
+    assert read_run(tmp_path / "run")["index"].tolist() == []
+    data = generate(SPEC, SPACE, 2, tmp_path / "run", max_iter=1, progress=None)
+    assert data["index"].tolist() == [0, 1]
+    assert read_run(tmp_path / "run")["index"].tolist() == [0, 1]
+    assert "refused" not in json.loads((tmp_path / "run" / "run.json").read_text())
