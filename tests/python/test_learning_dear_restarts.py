@@ -78,6 +78,9 @@ def test_farthest_picks_the_row_farthest_from_what_was_tried() -> None:
     diverged = np.array([np.nan, 0.0])
     assert farthest(pool, [pool[0], diverged], scale) == 2
     assert farthest(pool, [diverged], scale) == 0
+    # An empty pool has no row to give.
+    assert farthest(np.zeros((0, 2)), [pool[0]], scale) is None
+    assert farthest([], [], scale) is None
 
 
 def test_dear_guess_restarts_must_not_be_negative() -> None:

@@ -156,7 +156,10 @@ def farthest(
     aside), while farther ones reached the lower cost. Visited vectors with
     a NaN or infinite entry are left out.
     """
-    rows = np.atleast_2d(np.asarray(pool, dtype=float))
+    rows = np.asarray(pool, dtype=float)
+    if rows.size == 0:
+        return None
+    rows = np.atleast_2d(rows)
     s = np.asarray(scale, dtype=float)
     # A non-finite vector (a solve that ended on NaN) is no place in a basin,
     # and its NaN distances would hide every row.
