@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from roughwalk.errors import ConfigError, InvalidArgumentError
-from roughwalk.learning import Dataset, ProblemSpec, TaskSpace, generate
+from roughwalk.learning import Dataset, ProblemSpec, TaskSpace, experience, generate
 from roughwalk.learning.dataset import COLUMNS
 from roughwalk.learning.experience import jittered, read_run
 from roughwalk.learning.problem_spec import task_refusal
@@ -251,3 +251,40 @@ def test_a_run_leaves_out_the_tasks_the_problem_refuses(tmp_path: Path) -> None:
     meta = json.loads((tmp_path / "run" / "run.json").read_text())
     assert sorted(int(i) for i in meta["refused"]) == refused
     assert all("range of motion" in reason for reason in meta["refused"].values())
+
+
+def test_reading_a_run_solved_before_the_refusal_leaves_the_refused_out(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A folder solved before tasks were refused holds their solves; resumed, it
+    # records the refusals, and read_run (init train, init iterate) must leave
+    # them out as generate's dataset does.
+    spec = ProblemSpec("anymal_c", "single_pallet", "walk", 4, 2.0)
+    space = TaskSpace(
+        "edge", "single_pallet", (0.40, 0.30, -0.39), (0.50, 0.33, -0.38), (1.6, 0.0, 0.0)
+    )
+    refused = [i for i in range(6) if task_refusal(spec, space.task(i)) is not None]
+    assert refused
+    with monkeypatch.context() as m:
+        m.setattr(experience, "task_refusal", lambda spec, task: None)
+        generate(spec, space, 6, tmp_path / "run", max_iter=1, progress=None)
+    assert read_run(tmp_path / "run")["index"].tolist() == list(range(6))
+    data = generate(spec, space, 6, tmp_path / "run", max_iter=1, progress=None)
+    kept = sorted(set(range(6)) - set(refused))
+    assert data["index"].tolist() == kept
+    assert read_run(tmp_path / "run")["index"].tolist() == kept
+
+
+def test_a_task_no_longer_refused_is_solved_and_read_again(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A refusal recorded by an earlier check that no longer refuses the task
+    # must not keep its new solve out of read_run.
+    with monkeypatch.context() as m:
+        m.setattr(experience, "task_refusal", lambda spec, task: "refused by an older check")
+        generate(SPEC, SPACE, 2, tmp_path / "run", max_iter=1, progress=None)
+    assert read_run(tmp_path / "run")["index"].tolist() == []
+    data = generate(SPEC, SPACE, 2, tmp_path / "run", max_iter=1, progress=None)
+    assert data["index"].tolist() == [0, 1]
+    assert read_run(tmp_path / "run")["index"].tolist() == [0, 1]
+    assert "refused" not in json.loads((tmp_path / "run" / "run.json").read_text())

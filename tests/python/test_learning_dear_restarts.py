@@ -14,7 +14,9 @@ from roughwalk.learning.experience import generate
 from roughwalk.learning.initializer import LearnedInitializer, load_model
 from roughwalk.learning.model_constraints import constraints_for_model
 from roughwalk.learning.solution_library import farthest
+from roughwalk.trajopt.optimize import _cheaper
 from roughwalk.trajopt.parameters import SolverOptions
+from roughwalk.trajopt.solver import SolveOutcome, TrajoptStatus
 
 MODEL = "anymal_c_single_pallet_walk16"
 # Held-out task 58: the library's pick (and the network's own guess) converge
@@ -72,9 +74,53 @@ def test_farthest_picks_the_row_farthest_from_what_was_tried() -> None:
     assert farthest(pool, [pool[0], pool[2]], scale) == 1  # a tie at 0.71: the first
     assert farthest(pool, list(pool), scale) is None  # every row tried
     assert farthest(pool, [], scale) == 0
+    # A solve that ended on NaN (IPOPT's invalid number) hides no row.
+    diverged = np.array([np.nan, 0.0])
+    assert farthest(pool, [pool[0], diverged], scale) == 2
+    assert farthest(pool, [diverged], scale) == 0
+    # An empty pool has no row to give.
+    assert farthest(np.zeros((0, 2)), [pool[0]], scale) is None
+    assert farthest([], [], scale) is None
 
 
 def test_dear_guess_restarts_must_not_be_negative() -> None:
     assert SolverOptions(dear_guess_restarts=0).dear_guess_restarts == 0
     with pytest.raises(ConfigError, match="dear_guess_restarts"):
         SolverOptions(dear_guess_restarts=-1)
+
+
+def _outcome(objective: float, iterations: int, time_s: float, history: list) -> SolveOutcome:
+    empty = np.zeros(0)
+    return SolveOutcome(
+        TrajoptStatus.EXACT, "Solve_Succeeded", iterations, time_s,
+        empty, empty, empty, objective, empty, empty, history,
+    )  # fmt: skip
+
+
+def test_a_further_starts_history_runs_on_after_the_kept_ones() -> None:
+    # As after a fallback restart: the further start's entries are numbered and
+    # timed after the solves before it, and say which solve they are of.
+    kept = _outcome(
+        3.4,
+        50,
+        1.0,
+        [
+            {"iteration": 0.0, "elapsed_s": 0.0, "solve": 0.0},
+            {"iteration": 40.0, "elapsed_s": 0.7, "solve": 0.0},
+            {"iteration": 40.0, "elapsed_s": 0.7, "solve": 1.0},
+            {"iteration": 50.0, "elapsed_s": 1.0, "solve": 1.0},
+        ],
+    )
+    other = _outcome(
+        2.5, 8, 0.2, [{"iteration": 0.0, "elapsed_s": 0.0}, {"iteration": 8.0, "elapsed_s": 0.2}]
+    )
+    joined = _cheaper(kept, other)
+    assert joined.objective == 2.5 and joined.iterations == 58
+    assert [h["solve"] for h in joined.history] == [0.0, 0.0, 1.0, 1.0, 2.0, 2.0]
+    assert [h["iteration"] for h in joined.history][-2:] == [50.0, 58.0]
+    elapsed = [h["elapsed_s"] for h in joined.history]
+    assert all(b >= a for a, b in zip(elapsed, elapsed[1:], strict=False))
+    assert elapsed[-1] == pytest.approx(1.2)
+    # An untagged first solve (no fallback before) counts as solve 0.
+    plain = _cheaper(_outcome(3.4, 30, 0.5, [{"iteration": 30.0, "elapsed_s": 0.5}]), other)
+    assert [h["solve"] for h in plain.history] == [0.0, 1.0, 1.0]

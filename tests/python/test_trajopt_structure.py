@@ -330,3 +330,21 @@ def test_ipopt_options_are_part_of_the_structure_key() -> None:
         assert plain.structure_key() != other.structure_key()
     with pytest.raises(ConfigError, match="guess_ipopt_options entries are name=value"):
         SolverOptions(guess_ipopt_options=("mu_init",))
+
+
+def test_dropped_picked_samples_lend_no_jacobian_to_later_expressions() -> None:
+    # NodeSpline.picked is keyed by element hash, a node's address. A sample
+    # whose position its caller drops frees its nodes; a later expression
+    # (here the velocities of fresh samples) allocated at a freed address must
+    # not take the dropped position's Jacobian in points_jacobian.
+    x, v, d = ca.SX.sym("x", 3, 5), ca.SX.sym("v", 3, 5), ca.SX.sym("d", 4)
+    windows = [(0.0, 0.4), (0.2, 0.8), (0.4, 1.2), (0.6, 1.6)]
+    spline = NodeSpline(ca.horzsplit(x), ca.horzsplit(v), ca.vertsplit(d), windows)
+    z = ca.vertcat(ca.vec(x), ca.vec(v), d)
+    times = list(np.linspace(0.05, 1.1, 15))
+    values = np.random.default_rng(1).uniform(0.25, 0.35, int(z.numel()))
+    for _ in range(10):
+        spline.points(times)  # positions dropped
+        u = ca.vertcat(*[vel for _, vel, _ in spline.points(times)])
+        f = ca.Function("f", [z], [points_jacobian(u, z, spline.picked) - ca.jacobian(u, z)])
+        assert np.max(np.abs(np.asarray(f(values)))) < 1e-12

@@ -451,13 +451,16 @@ def generate(
         for i in wanted
         if (reason := task_refusal(spec, space.task(i, seed=seed, split=split))) is not None
     }
-    if refused:
-        run.meta["refused"] = {
-            **run.meta.get("refused", {}),
-            **{str(i): r for i, r in refused.items()},
-        }
+    # The record is today's for the wanted tasks (a check that changed since
+    # must not leave a task out of read_run), earlier runs' for the others.
+    checked = set(wanted)
+    record = {k: r for k, r in run.meta.get("refused", {}).items() if int(k) not in checked}
+    record.update({str(i): r for i, r in refused.items()})
+    if record != run.meta.get("refused", {}):
+        run.meta.pop("refused", None)
+        run.meta.update({"refused": record} if record else {})
         run._write_meta()
-        wanted = [i for i in wanted if i not in refused]
+    wanted = [i for i in wanted if i not in refused]
     done = run.done()
     todo = [i for i in wanted if i not in done]
     tasks = [space.task(i, seed=seed, split=split) for i in todo]
@@ -528,15 +531,21 @@ def jittered(
 
 
 def read_run(folder: str | Path) -> Dataset:
-    """The finished solves of a run folder (even one still running), without writing anything."""
+    """The finished solves of a run folder (even one still running), without writing anything.
+
+    Tasks the run records as refused are left out, as :func:`generate`'s
+    dataset leaves them: a folder solved before the refusal existed holds
+    their (infeasible) solves.
+    """
     path = Path(folder)
     meta_path = path / "run.json"
     if not meta_path.is_file():
         raise ConfigError(f"{path} is not an experience run (no run.json)")
     meta = json.loads(meta_path.read_text())
+    refused = {int(i) for i in meta.get("refused", {})}
     rows = []
     for item in sorted((path / "solves").glob("*.npz")):
-        if not item.stem.isdigit():
+        if not item.stem.isdigit() or int(item.stem) in refused:
             continue
         with np.load(item, allow_pickle=False) as data:
             rows.append(_row(data))

@@ -153,13 +153,20 @@ def farthest(
     another basin: on held-out single-pallet tasks 58 and 72 the library
     candidates within 1.9 of the poor solution (in this distance) ended in
     that same minimum (six of six on tasks 58, 72 and 102, the picks
-    aside), while farther ones reached the lower cost.
+    aside), while farther ones reached the lower cost. Visited vectors with
+    a NaN or infinite entry are left out.
     """
-    rows = np.atleast_2d(np.asarray(pool, dtype=float))
+    rows = np.asarray(pool, dtype=float)
+    if rows.size == 0:
+        return None
+    rows = np.atleast_2d(rows)
     s = np.asarray(scale, dtype=float)
-    if not len(visited):
+    # A non-finite vector (a solve that ended on NaN) is no place in a basin,
+    # and its NaN distances would hide every row.
+    finite = [v for v in visited if np.isfinite(np.asarray(v, dtype=float)).all()]
+    if not finite:
         return 0 if len(rows) else None
-    seen = np.atleast_2d(np.asarray(visited, dtype=float))
+    seen = np.atleast_2d(np.asarray(finite, dtype=float))
     d = np.sqrt((((rows[:, None, :] - seen[None, :, :]) / s) ** 2).mean(axis=2)).min(axis=1)
     best = int(np.argmax(d))
     return best if d[best] > same else None

@@ -389,36 +389,41 @@ def _joined(first: SolveOutcome, second: SolveOutcome, nlp: Formulation) -> Solv
     chosen = second
     if not second.status.solved and _max_violation(first, nlp) < _max_violation(second, nlp):
         chosen = first
-    history = [{**h, "solve": 0.0} for h in first.history] + [
-        {
-            **h,
-            "iteration": h.get("iteration", 0) + first.iterations,
-            "elapsed_s": h.get("elapsed_s", 0.0) + first.solve_time_s,
-            "solve": 1.0,
-        }
-        for h in second.history
-    ]
-    return replace(
-        chosen,
-        iterations=first.iterations + second.iterations,
-        solve_time_s=first.solve_time_s + second.solve_time_s,
-        history=history,
-    )
+    return _paid(chosen, first, second)
 
 
 def _cheaper(kept: SolveOutcome, other: SolveOutcome) -> SolveOutcome:
     """The cheaper converged outcome of a converged ``kept`` and a further start's; both paid.
 
-    Iterations and time are the sum of both solves; the history runs on.
+    Iterations and time are the sum of both solves; the history runs on as
+    :func:`_joined`'s does: numbers and times after ``kept``'s, and each
+    entry's ``solve`` one after the last solve's (0 for an untagged first).
     """
     chosen = other if other.status.solved and other.objective < kept.objective else kept
-    history = list(kept.history) + [
-        {**h, "iteration": h.get("iteration", 0) + kept.iterations} for h in other.history
+    return _paid(chosen, kept, other)
+
+
+def _paid(chosen: SolveOutcome, before: SolveOutcome, after: SolveOutcome) -> SolveOutcome:
+    """``chosen`` with the iterations, time and history of the solves ``before`` and ``after``.
+
+    ``after``'s entries are numbered and timed after ``before``'s, and tagged
+    one solve after its last (``before``'s untagged entries are solve 0).
+    """
+    first = [h if "solve" in h else {**h, "solve": 0.0} for h in before.history]
+    number = max((h["solve"] for h in first), default=-1.0) + 1.0
+    history = first + [
+        {
+            **h,
+            "iteration": h.get("iteration", 0) + before.iterations,
+            "elapsed_s": h.get("elapsed_s", 0.0) + before.solve_time_s,
+            "solve": number,
+        }
+        for h in after.history
     ]
     return replace(
         chosen,
-        iterations=kept.iterations + other.iterations,
-        solve_time_s=kept.solve_time_s + other.solve_time_s,
+        iterations=before.iterations + after.iterations,
+        solve_time_s=before.solve_time_s + after.solve_time_s,
         history=history,
     )
 

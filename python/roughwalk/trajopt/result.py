@@ -128,7 +128,8 @@ class TrajoptResult:
         IPOPT's own return status.
     history:
         Per iteration: objective, violation and elapsed time; after a restart
-        from an initialiser's fallback guess, also which solve (0, 1) it is of.
+        from an initialiser's fallback guess or a further start, also which
+        solve (0, 1, ...) it is of.
     x:
         The solution vector (for warm starts).
     lam_x, lam_g:

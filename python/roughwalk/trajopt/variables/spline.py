@@ -261,7 +261,7 @@ class NodeSpline:
         pos, vel, acc, jac = _pick_function(dim, n)(
             t, ca.vertcat(*lo), ca.vertcat(*hi), self.basis[index]
         )
-        call = PickCall(self, index, jac)
+        call = PickCall(self, index, jac, pos)
         for i in range(dim):
             self.picked[pos[i].element_hash()] = (call, i)
         return pos, vel, acc
@@ -298,7 +298,7 @@ class NodeSpline:
             for c, (j, p, v, a) in enumerate(
                 zip(members, ca.horzsplit(pos), ca.horzsplit(vel), ca.horzsplit(acc), strict=True)
             ):
-                call = PickCall(self, indices[c], jacobians[c])
+                call = PickCall(self, indices[c], jacobians[c], p)
                 for i in range(dim):
                     self.picked[hashes[c * dim + i]] = (call, i)
                 out[j] = (p, v, a)
@@ -337,11 +337,16 @@ class PickCall:
     Its inputs q are ``spline.basis[index]``, affine in the variables, so
     ∂position/∂x = ``jacobian`` · ∂basis[index]/∂x with the second factor
     constant (:func:`~roughwalk.trajopt.point_jacobian.points_jacobian`).
+    ``position`` is the sample itself, held so that its entries' element
+    hashes (the keys of :attr:`NodeSpline.picked`: node addresses) stay
+    theirs: a sample dropped by its caller frees its nodes, and a later
+    expression allocated at the same address would take its Jacobian.
     """
 
     spline: NodeSpline
     index: list[int]
     jacobian: ca.SX
+    position: ca.SX
 
 
 def sample_points(
