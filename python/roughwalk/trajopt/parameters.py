@@ -477,7 +477,9 @@ class TrajoptConfig:
         Least height of the base above every foot (Melon's base-above-feet
         constraint), as a fraction of the nominal base height.
     init:
-        Initial guess: "heuristic", "footsteps:PLAN.json" or "learned".
+        Initial guess: "heuristic", "footsteps:PLAN.json" or "learned"
+        ("heuristic:even" keeps Melon's evenly spaced footholds on level
+        ground too; see :class:`~roughwalk.trajopt.HeuristicInitializer`).
     terrain:
         Terrain smoothing (:class:`TerrainModelConfig`).
     solver:
