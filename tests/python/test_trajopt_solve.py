@@ -233,8 +233,8 @@ def test_towr_feasibility_problem_reuses_its_build_and_warm_starts() -> None:
 
 def test_towr_block_solves_unscaled_in_fewer_iterations_than_scaled() -> None:
     # TOWR's block, goal 1.5 m (T = 3.5 s, walk): 106 iterations with IPOPT's
-    # gradient-based NLP scaling, 41 without (towr_config's default), and the
-    # unscaled rows still meet constr_viol_tol.
+    # gradient-based NLP scaling (and no other option), 41 without, 33 with
+    # towr_config's options, and the unscaled rows still meet constr_viol_tol.
     from dataclasses import replace
 
     config = towr_config()
@@ -247,6 +247,22 @@ def test_towr_block_solves_unscaled_in_fewer_iterations_than_scaled() -> None:
     assert unscaled_result.solved and scaled_result.solved
     assert unscaled_result.max_violation <= config.solver.constr_viol_tol
     assert unscaled_result.iterations < 0.6 * scaled_result.iterations
+
+
+def test_towr_gap_trot_never_falls_back_to_the_monotone_barrier() -> None:
+    # TOWR's gap trot, goal 2.5 m (fixed durations): 183 iterations when
+    # IPOPT's adaptive barrier update may fall back to its monotone mode, 33
+    # when it never does (towr_config's default with fixed durations only).
+    option = "adaptive_mu_globalization=never-monotone-mode"
+    assert option not in towr_config(optimize_durations=True).solver.ipopt_options
+    config = towr_config()
+    assert option in config.solver.ipopt_options
+    task = ((0.0, 0.0, 0.0), (2.5, 0.0, 0.0))
+    result = optimize_motion(
+        None, "towr_gap", task, config=config, gait="trot", steps=16, duration=3.5
+    )
+    assert result.solved and result.max_violation <= config.solver.constr_viol_tol
+    assert result.iterations <= 60
 
 
 def test_towr_block_goal_with_hind_feet_at_the_edge_solves() -> None:

@@ -477,7 +477,9 @@ class TrajoptConfig:
         Least height of the base above every foot (Melon's base-above-feet
         constraint), as a fraction of the nominal base height.
     init:
-        Initial guess: "heuristic", "footsteps:PLAN.json" or "learned".
+        Initial guess: "heuristic", "footsteps:PLAN.json" or "learned"
+        ("heuristic:even" keeps Melon's evenly spaced footholds on level
+        ground too; see :class:`~roughwalk.trajopt.HeuristicInitializer`).
     terrain:
         Terrain smoothing (:class:`TerrainModelConfig`).
     solver:
@@ -613,7 +615,11 @@ def towr_config(**changes: object) -> TrajoptConfig:
     guess with bounds 14, 17, 26, 26, 34, 56 and 23; either change alone
     won on some tasks and lost on others. One task's count is a sample of
     that spread (flat trot 11–29, block 1.5 m 60–106), which holds TOWR's
-    13 and 22–64.
+    13 and 22–64. Since session 11 the heuristic puts each foothold on
+    level ground under the base at the middle of its stance (see
+    :class:`~roughwalk.trajopt.HeuristicInitializer`): the flat trot over
+    the goals 1.4–1.6 m took 8, 11, 11, 8, 12 iterations (was 15, 11, 22,
+    21, 12); the tasks on uneven ground are unchanged.
 
     One IPOPT option differs from TOWR's: no NLP scaling
     (``nlp_scaling_method=none``; IPOPT's default divides rows whose gradient
@@ -632,13 +638,32 @@ def towr_config(**changes: object) -> TrajoptConfig:
     from 11, 11, 12, 13, 13 to 12, 12, 11, 13, 15; with fixed durations the
     block 1.0 m from 18 to 45, the gap walk from 55 to 155 and the bound from
     28 to 71.
+
+    With fixed durations IPOPT's adaptive barrier update never falls back
+    to its monotone mode (``adaptive_mu_globalization=never-monotone-mode``,
+    session 11): the fallback came near convergence (the flat trot at
+    barrier 4e-10 jumped back to 5e-7 and spent 4 dear iterations, 2–3× the
+    cost of the first ones). Iterations of the benchmark rows, fixed
+    durations, from the level-ground guess: flat walk 10 → 10, flat trot
+    11 → 8, block 1.0/1.5 m 18/41 → 18/33, stairs 1.0/1.5/2.0 m 23/14/16 →
+    20/14/19, gap walk 55 → 52, gap trot 183 → 33, bound 28 → 28, slope
+    25 → 21; goals moved ±0.1 m: flat trot 1.4–1.6 m 8, 11, 11, 8, 12 → 8,
+    8, 8, 8, 12, block 1.4/1.6 m 48/42 → 39/34, gap walk 1.9 m 66 → 49,
+    bound 1.9/2.1 m 858/456 → 734/252, stairs 1.9/2.1 m 44/17 → 20/17,
+    slope 1.9/2.1 m 41/28 → 37/28, gap trot 2.4/2.6 m 24/27 both (the gap
+    walk at 2.1 m stops at the time limit either way). With optimised
+    durations it is not set: stairs 1.0 m 40 → 52 and 1.1 m 185 → stopped
+    by the limit, though block 1.4/1.5/1.6 m went 298 (limit)/49/94 →
+    47/31/26. ``kkt-error`` did as well on the flat trot but took the
+    block 1.5 m to 64 and the bound to 72.
     """
+    options: tuple[str, ...] = ("nlp_scaling_method=none",)
+    if not changes.get("optimize_durations", False):
+        options += ("adaptive_mu_globalization=never-monotone-mode",)
     base = TrajoptConfig(
         constraints=TOWR_CONSTRAINTS,
         costs=CostWeights.none(),
         body_model="towr_anymal",
-        solver=SolverOptions(
-            tol=1e-8, acceptable_tol=1e-6, ipopt_options=("nlp_scaling_method=none",)
-        ),
+        solver=SolverOptions(tol=1e-8, acceptable_tol=1e-6, ipopt_options=options),
     )
     return replace(base, **changes)  # type: ignore[arg-type]

@@ -17,10 +17,12 @@ __all__ = [
     "pack_guess",
     "off_edges",
     "level_goal_stance",
+    "EDGE_COST",
 ]
 
 _FLAT_SLOPE = 0.3  # steeper ground than this is no place for a guessed foothold
-_EDGE_COST = 0.2  # nor is ground this close to an edge (edge cost exp(−x_s²/2σ²))
+EDGE_COST = 0.2
+"""Guessed footholds keep off ground whose step-edge cost exp(−x_s²/2σ²) exceeds this."""
 
 
 def node_times(
@@ -102,7 +104,7 @@ def off_edges(
     points = foothold[None, :2] + offsets[:, None] * unit[None, :]
     values = nlp.terrain.evaluate(points)
     slope = np.hypot(values[:, 1], values[:, 2])
-    good = np.flatnonzero((slope < _FLAT_SLOPE) & (values[:, 3] < _EDGE_COST))
+    good = np.flatnonzero((slope < _FLAT_SLOPE) & (values[:, 3] < EDGE_COST))
     best = int(good[0]) if good.size else 0
     return np.array([points[best, 0], points[best, 1], values[best, 0]])
 
@@ -131,7 +133,7 @@ def level_goal_stance(
     values = nlp.terrain.evaluate(points.reshape(-1, 2)).reshape(len(feet), len(offsets), 4)
     heights = values[:, :, 0]
     slope = np.hypot(values[:, :, 1], values[:, :, 2])
-    good = (slope < _FLAT_SLOPE) & (values[:, :, 3] < _EDGE_COST)
+    good = (slope < _FLAT_SLOPE) & (values[:, :, 3] < EDGE_COST)
     best: tuple[tuple[int, float], NDArray[np.float64]] | None = None
     for level in np.unique(np.concatenate([feet[:, 2] - dz, feet[:, 2], feet[:, 2] + dz])):
         chosen = feet.copy()
