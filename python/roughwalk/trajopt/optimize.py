@@ -27,7 +27,7 @@ from roughwalk.trajopt import compiled_nlp, serialized_nlp
 from roughwalk.trajopt.formulation import Formulation
 from roughwalk.trajopt.gaits import ContactSchedule, make_gait
 from roughwalk.trajopt.initializers import Initializer, make_initializer
-from roughwalk.trajopt.parameters import TrajoptConfig, melon_config
+from roughwalk.trajopt.parameters import SolverOptions, TrajoptConfig, melon_config
 from roughwalk.trajopt.result import Splines, TrajoptResult
 from roughwalk.trajopt.robot_model import SingleRigidBody, rigid_body_model
 from roughwalk.trajopt.solver import (
@@ -100,7 +100,7 @@ class TrajoptProblem:
         "serialized" (built and stored in CasADi's serialised form: the build
         time includes the writing) or "deserialized" (read from that form)."""
         self.formulation = self._formulation()
-        self.solver = TrajoptSolver(self.formulation, config.solver)
+        self.solver = TrajoptSolver(self.formulation, solver_options_for(config))
         self.build_time_s = time.perf_counter() - start
         self._build_pending = True
 
@@ -375,6 +375,20 @@ class TrajoptProblem:
 def _restartable(status: TrajoptStatus) -> bool:
     """Whether a first solve that ended with ``status`` is restarted from the fallback."""
     return not status.solved and status not in (TrajoptStatus.CANCELLED, TrajoptStatus.TIMEOUT)
+
+
+def solver_options_for(config: TrajoptConfig) -> SolverOptions:
+    """``config``'s solver options with those its duration mode adds.
+
+    ``fixed_durations_ipopt_options`` join ``ipopt_options`` when the phase
+    durations are fixed; decided here, from the config the NLP is built
+    with, so ``--set optimize_durations=true`` on a preset drops them.
+    """
+    solver = config.solver
+    if config.optimize_durations or not solver.fixed_durations_ipopt_options:
+        return solver
+    extra = solver.fixed_durations_ipopt_options
+    return replace(solver, ipopt_options=solver.ipopt_options + extra)
 
 
 def _joined(first: SolveOutcome, second: SolveOutcome, nlp: Formulation) -> SolveOutcome:

@@ -273,6 +273,11 @@ class SolverOptions:
     ipopt_options:
         Further IPOPT options as "name=value" strings (numbers are converted),
         e.g. ("mu_strategy=adaptive",).
+    fixed_durations_ipopt_options:
+        IPOPT options, on top of ``ipopt_options``, of a problem whose phase
+        durations are fixed (``optimize_durations`` false); chosen when the
+        solver is built, so a config changed to optimise durations after it
+        was made does not carry them (see :func:`towr_config`).
     warm_ipopt_options:
         IPOPT options, on top of the others, of a solve restarted from a
         previous solution and its multipliers (``warm_start=``): IPOPT's warm
@@ -393,13 +398,19 @@ class SolverOptions:
     mumps_scaling: bool | None = None
     print_level: int = 0
     ipopt_options: tuple[str, ...] = ()
+    fixed_durations_ipopt_options: tuple[str, ...] = ()
     warm_ipopt_options: tuple[str, ...] = WARM_START_OPTIONS
     guess_ipopt_options: tuple[str, ...] = GUESS_START_OPTIONS
     guess_fallback_after: int | None = 50
     dear_guess_restarts: int = 3
 
     def __post_init__(self) -> None:
-        for field_name in ("ipopt_options", "warm_ipopt_options", "guess_ipopt_options"):
+        for field_name in (
+            "ipopt_options",
+            "fixed_durations_ipopt_options",
+            "warm_ipopt_options",
+            "guess_ipopt_options",
+        ):
             for item in getattr(self, field_name):
                 if "=" not in item:
                     raise ConfigError(f"solver.{field_name} entries are name=value, got {item!r}")
@@ -657,13 +668,15 @@ def towr_config(**changes: object) -> TrajoptConfig:
     47/31/26. ``kkt-error`` did as well on the flat trot but took the
     block 1.5 m to 64 and the bound to 72.
     """
-    options: tuple[str, ...] = ("nlp_scaling_method=none",)
-    if not changes.get("optimize_durations", False):
-        options += ("adaptive_mu_globalization=never-monotone-mode",)
     base = TrajoptConfig(
         constraints=TOWR_CONSTRAINTS,
         costs=CostWeights.none(),
         body_model="towr_anymal",
-        solver=SolverOptions(tol=1e-8, acceptable_tol=1e-6, ipopt_options=options),
+        solver=SolverOptions(
+            tol=1e-8,
+            acceptable_tol=1e-6,
+            ipopt_options=("nlp_scaling_method=none",),
+            fixed_durations_ipopt_options=("adaptive_mu_globalization=never-monotone-mode",),
+        ),
     )
     return replace(base, **changes)  # type: ignore[arg-type]
