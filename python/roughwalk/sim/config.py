@@ -389,6 +389,27 @@ class ReflexConfig:
     replan_budget_s:
         Time the anytime planner gets to re-plan [s] (the paper's target: walk
         again within 2 s).
+    standing_bear:
+        While the recovery puts the unloaded feet down, the supporting feet
+        still on the ground (:func:`~roughwalk.sim.recovery.standing_feet`)
+        keep bearing the trunk, loaded at that instant or not. Off (default):
+        only the feet loaded at that instant bear it, the others are
+        unweighted and softened as for a touchdown. Board AE (bench large
+        rocks seed 0, ``--expansions 40000``), with ``timing.measured_speed``
+        0.9 and ``timing.min_swing_s`` 0.2: at the first reflex (0.79 s,
+        LH's swing) only RF measured load (RH chattered on a rock face, LF
+        had let go), the whole 26.6 N went to RF and the robot rolled over
+        (34° at 1.41 s); on, that reflex is survived and re-planned, but the
+        run falls at 4.14 s after two more. With the default timing the
+        same course, won after two reflexes with it off, ends after four
+        in a failed re-plan with it on: the reflexes' outcomes on that board
+        are chaotic, and two seeds do not tell the better setting.
+    replan_nudge_m:
+        Where the stance the feet stand on after a recovery has no pose
+        certificate (nor, within 2.5 cm, the one they were headed for), the
+        re-plan starts from the nearest stance with one foot moved 1 cm at a
+        time up to this far [m] that has one; the integrators absorb the
+        difference. 0 (default): no such search, and the run ends there.
     max_reflexes:
         Give up (a failed run) after this many reflexes.
     """
@@ -407,6 +428,8 @@ class ReflexConfig:
     lower_s: float = 0.5
     capture_max_m: float = 0.04
     replan_budget_s: float = 2.0
+    standing_bear: bool = False
+    replan_nudge_m: float = 0.0
     max_reflexes: int = 6
 
     def __post_init__(self) -> None:
@@ -431,6 +454,7 @@ class ReflexConfig:
                 "persist_s",
                 "settle_s",
                 "capture_max_m",
+                "replan_nudge_m",
                 "settle_max_s",
             ),
             "reflex",
