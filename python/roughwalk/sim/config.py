@@ -377,6 +377,17 @@ class ReflexConfig:
         After ``settle_s`` the hold goes on while the trunk turns faster than
         this [rad/s] or a foot bears no load (a trunk still rocking from its
         left feet to its right ones): lifting a foot then tips it over.
+    foot_force_per_leg:
+        The foot-force error persists only while the same foot stays short
+        of load (off, default: while any foot is). Board AE (bench large
+        rocks seed 0, ``--expansions 40000``) with ``timing.measured_speed``
+        0.9 and ``timing.min_swing_s`` 0.2: as LH landed (0.77–0.79 s) RH
+        chattered on a rock face (0 N every other 2 ms tick) and LF let go
+        for a few ticks at a time; no foot lost its load for 0.03 s, but
+        the reflex fired, the recovery lowered three feet onto RF alone and
+        the robot rolled over (34° at 1.41 s). With this, ``standing_bear``
+        and ``replan_nudge_m`` 0.02 that run reaches the goal (2.78 cm/s,
+        three reflexes later in the course).
     settle_max_s:
         Longest extension [s] of the hold for that; then the re-plan starts anyway.
     lower_s:
@@ -421,6 +432,7 @@ class ReflexConfig:
     foot_force_n: float = 2.0
     foot_force_fraction: float = 0.05
     foot_force_tilt_rad: float = 0.03
+    foot_force_per_leg: bool = False
     persist_s: float = 0.03
     settle_s: float = 0.3
     settled_rate_rad_s: float = 0.2
