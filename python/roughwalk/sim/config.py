@@ -387,7 +387,16 @@ class ReflexConfig:
         the reflex fired, the recovery lowered three feet onto RF alone and
         the robot rolled over (34° at 1.41 s). With this, ``standing_bear``
         and ``replan_nudge_m`` 0.02 that run reaches the goal (2.78 cm/s,
-        three reflexes later in the course).
+        three reflexes later in the course). The three together on the
+        repeatable bench (``roughwalk bench littledog --expansions 40000
+        --seeds 2``; only runs with a reflex can change): with that timing
+        large rocks 1/2 → 2/2 at 3.80 cm/s (seed 0 2.78, 3 reflexes),
+        barrier 2/2 at 5.62 → 5.61, sloped rocks 1/2 at 6.90 (seed 1 still
+        fails: its nudged re-plan finds no certificate within 2 cm); with
+        the default timing no run lost, but large rocks seed 0 2.79 → 2.25
+        (3 reflexes, not 2) and logs seed 1 4.01 → 3.52 (barrier 4.73 and
+        sloped rocks 1/2 at 5.90 unchanged). Off by default while the
+        measured timing is.
     settle_max_s:
         Longest extension [s] of the hold for that; then the re-plan starts anyway.
     lower_s:
