@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 import roughwalk
-from roughwalk.sim.recovery import centred_fit, off_edge, recovery_segment
+from roughwalk.sim.executor import nudged_stances
+from roughwalk.sim.recovery import centred_fit, off_edge, recovery_segment, standing_feet
 from roughwalk.sim.runner import Runner
 from roughwalk.sim.world import World
 from roughwalk.trajectories.body_keyframes import nominal_fit
@@ -61,6 +62,35 @@ def test_a_trunk_heading_for_the_lifted_foot_moves_it_to_the_capture_point(stand
     # Capture off: straight down.
     off = footholds(standing, [0.0, 0.2, 0.0], capture_max_m=0.0)
     np.testing.assert_allclose(off[2, :2], measured.feet[2, :2], atol=1e-12)
+
+
+def test_a_supporting_foot_on_the_ground_stands_though_it_bears_no_load_this_instant(
+    standing,
+) -> None:
+    """Board AE, bench large rocks seed 0: at the reflex only RF bore load.
+
+    RH chattered on a rock face and LF had let go for the instant; taken
+    for lifted, their weight went to RF alone and the robot rolled over.
+    """
+    robot, terrain, measured = standing
+    forces = np.zeros((4, 3))
+    forces[1, 2] = 12.0  # only RF loaded
+    feet = measured.feet.copy()
+    feet[2, 2] += 0.03  # LH 3 cm up: swinging
+    feet[3, 2] += 0.004  # RH a few mm up: chattering on its foothold
+    at_reflex = dataclasses.replace(measured, foot_forces=forces, feet=feet)
+    support = np.array([True, True, False, True])  # LH swings
+    down = standing_feet(robot, terrain, at_reflex, support, 1.0)
+    np.testing.assert_array_equal(down, [True, True, False, True])
+    # Where the plan had a foot in the air, only its load says it stands.
+    swinging = np.array([False, True, False, True])
+    down = standing_feet(robot, terrain, at_reflex, swinging, 1.0)
+    np.testing.assert_array_equal(down, [False, True, False, True])
+    # A supporting foot lifted 3 cm (a slip off an edge) does not stand.
+    feet[3, 2] += 0.03
+    lifted = dataclasses.replace(at_reflex, feet=feet)
+    down = standing_feet(robot, terrain, lifted, support, 1.0)
+    np.testing.assert_array_equal(down, [True, True, False, False])
 
 
 def test_a_foot_caught_over_a_steps_edge_goes_down_on_the_step_not_on_its_corner(standing) -> None:
@@ -121,3 +151,24 @@ def test_the_trunk_settles_with_its_centre_of_mass_over_the_feet_on_a_tilted_sta
     fit_pos, _ = nominal_fit(WholeBody(robot), feet)
     q, _ = robot.inverse_kinematics(feet, fit_pos, quat)
     assert robot.center_of_mass(q, fit_pos, quat)[1] - feet[:, 1].mean() > 0.02
+
+
+def test_a_replan_without_a_start_certificate_tries_stances_one_foot_moved_nearest_first(
+    standing,
+) -> None:
+    """``reflex.replan_nudge_m``: the candidates, the leg that lifts first first."""
+    _, _, measured = standing
+    feet = measured.feet
+    stances = list(nudged_stances(feet, 0.02, first_leg=2))
+    assert len(stances) == 2 * 4 * 8
+    moved = np.array([np.linalg.norm(s[:, :2] - feet[:, :2], axis=1) for s in stances])
+    # One foot at a time, never its height, 1 cm before 2 cm.
+    assert np.all(np.count_nonzero(moved > 1e-12, axis=1) == 1)
+    np.testing.assert_allclose(moved.max(axis=1), [0.01] * 32 + [0.02] * 32)
+    np.testing.assert_array_equal(
+        np.array([s[:, 2] for s in stances]), np.tile(feet[:, 2], (64, 1))
+    )
+    # LH (the next to lift) first at each distance, then LF, RF, RH.
+    legs = moved.argmax(axis=1)
+    np.testing.assert_array_equal(legs[:32], np.repeat([2, 0, 1, 3], 8))
+    assert list(nudged_stances(feet, 0.0)) == []

@@ -325,3 +325,62 @@ def test_reflex_fires_only_on_errors_that_persist(littledog) -> None:
     assert hits and hits[0] == 25  # 10 + 0.03 s / 0.002 s
     assert fired[25].kind == "body_position"
     assert fired[25].value == pytest.approx(0.03)
+
+
+def _three_feet_down(robot: roughwalk.Robot) -> object:
+    """The desired state of the nominal stance with LH lifted (LF, RF, RH bear the trunk)."""
+    st = robot.nominal_stance
+    base = np.array([0.5, 0.0, st.base_height])
+    feet = st.feet + base
+    segment = pose_segment(
+        robot,
+        np.array([base, base]),
+        np.zeros((2, 3)),
+        np.array([feet, feet]),
+        np.array([True, True, False, True]),
+        1.0,
+        "hold",
+        0.0,
+    )
+    return segment.sample(0.0)
+
+
+def _foot_force_hits(littledog, per_leg: bool, short_legs) -> list[int]:
+    """Ticks at which the foot-force reflex fires; ``short_legs(k)``: the feet unloaded at k."""
+    monitor = ReflexMonitor(ReflexConfig(persist_s=0.03, foot_force_per_leg=per_leg))
+    desired = _three_feet_down(littledog)
+    measured = type("M", (), {})()
+    measured.feet = desired.feet.copy()
+    measured.base_pos = desired.base_pos.copy()
+    tilt = 0.05  # beyond foot_force_tilt_rad: the trunk tips
+    measured.base_quat = np.array([np.cos(tilt / 2), np.sin(tilt / 2), 0.0, 0.0])
+    hits = []
+    for k in range(60):
+        measured.time = 0.002 * k
+        forces = desired.forces.copy()
+        forces[short_legs(k), 2] = 0.0
+        measured.foot_forces = forces
+        trigger = monitor.check(desired, measured)
+        if trigger is not None and trigger.kind == "foot_force":
+            hits.append(k)
+    return hits
+
+
+def test_a_foot_force_reflex_per_leg_waits_for_one_foot_short_of_load_throughout(
+    littledog,
+) -> None:
+    """``reflex.foot_force_per_leg``: board AE, bench large rocks seed 0, at 0.77-0.79 s.
+
+    RH chattered on a rock face (0 N every other tick) while LF let go for
+    a few ticks at a time: no one foot lost its load for 0.03 s, but some
+    foot always lacked it, and the reflex fired.
+    """
+    # LF (0) and RH (3) short of load in turn, 2 ticks each.
+    in_turn = lambda k: [0] if (k // 2) % 2 == 0 else [3]  # noqa: E731
+    assert _foot_force_hits(littledog, False, in_turn)  # any foot: fires
+    assert _foot_force_hits(littledog, True, in_turn) == []
+    # One foot short throughout fires with either, the persistence time
+    # after the feet count as settled (down 0.06 s: tick 30).
+    lf = lambda k: [0] if k >= 10 else []  # noqa: E731
+    assert _foot_force_hits(littledog, False, lf)[0] == 45
+    assert _foot_force_hits(littledog, True, lf)[0] == 45

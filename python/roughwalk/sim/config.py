@@ -377,6 +377,26 @@ class ReflexConfig:
         After ``settle_s`` the hold goes on while the trunk turns faster than
         this [rad/s] or a foot bears no load (a trunk still rocking from its
         left feet to its right ones): lifting a foot then tips it over.
+    foot_force_per_leg:
+        The foot-force error persists only while the same foot stays short
+        of load (off, default: while any foot is). Board AE (bench large
+        rocks seed 0, ``--expansions 40000``) with ``timing.measured_speed``
+        0.9 and ``timing.min_swing_s`` 0.2: as LH landed (0.77–0.79 s) RH
+        chattered on a rock face (0 N every other 2 ms tick) and LF let go
+        for a few ticks at a time; no foot lost its load for 0.03 s, but
+        the reflex fired, the recovery lowered three feet onto RF alone and
+        the robot rolled over (34° at 1.41 s). With this, ``standing_bear``
+        and ``replan_nudge_m`` 0.02 that run reaches the goal (2.78 cm/s,
+        three reflexes later in the course). The three together on the
+        repeatable bench (``roughwalk bench littledog --expansions 40000
+        --seeds 2``; only runs with a reflex can change): with that timing
+        large rocks 1/2 → 2/2 at 3.80 cm/s (seed 0 2.78, 3 reflexes),
+        barrier 2/2 at 5.62 → 5.61, sloped rocks 1/2 at 6.90 (seed 1 still
+        fails: its nudged re-plan finds no certificate within 2 cm); with
+        the default timing no run lost, but large rocks seed 0 2.79 → 2.25
+        (3 reflexes, not 2) and logs seed 1 4.01 → 3.52 (barrier 4.73 and
+        sloped rocks 1/2 at 5.90 unchanged). Off by default while the
+        measured timing is.
     settle_max_s:
         Longest extension [s] of the hold for that; then the re-plan starts anyway.
     lower_s:
@@ -389,6 +409,27 @@ class ReflexConfig:
     replan_budget_s:
         Time the anytime planner gets to re-plan [s] (the paper's target: walk
         again within 2 s).
+    standing_bear:
+        While the recovery puts the unloaded feet down, the supporting feet
+        still on the ground (:func:`~roughwalk.sim.recovery.standing_feet`)
+        keep bearing the trunk, loaded at that instant or not. Off (default):
+        only the feet loaded at that instant bear it, the others are
+        unweighted and softened as for a touchdown. Board AE (bench large
+        rocks seed 0, ``--expansions 40000``), with ``timing.measured_speed``
+        0.9 and ``timing.min_swing_s`` 0.2: at the first reflex (0.79 s,
+        LH's swing) only RF measured load (RH chattered on a rock face, LF
+        had let go), the whole 26.6 N went to RF and the robot rolled over
+        (34° at 1.41 s); on, that reflex is survived and re-planned, but the
+        run falls at 4.14 s after two more. With the default timing the
+        same course, won after two reflexes with it off, ends after four
+        in a failed re-plan with it on: the reflexes' outcomes on that board
+        are chaotic, and two seeds do not tell the better setting.
+    replan_nudge_m:
+        Where the stance the feet stand on after a recovery has no pose
+        certificate (nor, within 2.5 cm, the one they were headed for), the
+        re-plan starts from the nearest stance with one foot moved 1 cm at a
+        time up to this far [m] that has one; the integrators absorb the
+        difference. 0 (default): no such search, and the run ends there.
     max_reflexes:
         Give up (a failed run) after this many reflexes.
     """
@@ -400,6 +441,7 @@ class ReflexConfig:
     foot_force_n: float = 2.0
     foot_force_fraction: float = 0.05
     foot_force_tilt_rad: float = 0.03
+    foot_force_per_leg: bool = False
     persist_s: float = 0.03
     settle_s: float = 0.3
     settled_rate_rad_s: float = 0.2
@@ -407,6 +449,8 @@ class ReflexConfig:
     lower_s: float = 0.5
     capture_max_m: float = 0.04
     replan_budget_s: float = 2.0
+    standing_bear: bool = False
+    replan_nudge_m: float = 0.0
     max_reflexes: int = 6
 
     def __post_init__(self) -> None:
@@ -431,6 +475,7 @@ class ReflexConfig:
                 "persist_s",
                 "settle_s",
                 "capture_max_m",
+                "replan_nudge_m",
                 "settle_max_s",
             ),
             "reflex",

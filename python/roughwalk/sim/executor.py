@@ -37,7 +37,13 @@ from roughwalk.sim.footstep_source import FootstepSource, PlanAttempt, PlanStart
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
 from roughwalk.sim.outcome import Outcome, OutcomeMonitor
-from roughwalk.sim.recovery import blend_segment, hold_segment, pose_segment, recovery_segment
+from roughwalk.sim.recovery import (
+    blend_segment,
+    hold_segment,
+    pose_segment,
+    recovery_segment,
+    standing_feet,
+)
 from roughwalk.sim.reflexes import ReflexMonitor
 from roughwalk.sim.run_log import RunLog
 from roughwalk.sim.runner import Runner
@@ -70,6 +76,27 @@ _LOADED_N = 1.0
 # How far [m] a foot may have settled from its planned foothold for a re-plan
 # to start from the planned one.
 _NEAR_PLAN_M = 0.025
+
+
+def nudged_stances(
+    feet: np.ndarray, largest_m: float, first_leg: int | None = None
+) -> Iterator[np.ndarray]:
+    """Stances (4, 3) [m] with one foot of ``feet`` moved, nearest first.
+
+    Each foot in turn (``first_leg`` first: it lifts first, so its start
+    matters least), 1 cm at a time up to ``largest_m``, in eight
+    directions: the candidates a re-plan starts from when the stance where
+    the feet stand has no pose certificate.
+    """
+    n = int(np.floor(largest_m / 0.01 + 1e-9))
+    angles = np.arange(8) * (np.pi / 4)
+    legs = sorted(range(4), key=lambda leg: leg != first_leg)
+    for r in 0.01 * np.arange(1, n + 1):
+        for leg in legs:
+            for a in angles:
+                moved = np.array(feet, dtype=float, copy=True)
+                moved[leg, :2] += r * np.array([np.cos(a), np.sin(a)])
+                yield moved
 
 
 class _Plan:
@@ -431,6 +458,13 @@ class Executor:
         self._settle_deadline = None
         self._reflex_planned_feet = np.array(planned, dtype=float)
         in_contact = measured.foot_forces[:, 2] > _LOADED_N
+        bearing = (
+            standing_feet(
+                self.robot, self.terrain_for_recovery, measured, desired.support, _LOADED_N
+            )
+            if cfg.standing_bear
+            else in_contact
+        )
         self._plan = None
         self.buffer.clear()
         self.integrator.reset()
@@ -447,6 +481,7 @@ class Executor:
             cfg.settle_s,
             now,
             capture_max_m=cfg.capture_max_m,
+            bearing=bearing,
         )
         for s in segments:
             self.buffer.append(s)
@@ -536,6 +571,18 @@ class Executor:
             start = PlanStart(feet=planned.copy(), next_leg=start.next_leg)
             plan, attempt, wall2 = self._make_plan(start, goal, budget)
             wall += wall2
+        nudge = self.config.reflex.replan_nudge_m
+        if plan is None and "pose certificate" in attempt.reason and nudge > 0:
+            # No certificate where the feet stand nor where they were headed
+            # (board Y, sloped rocks seed 1: a foot out of reach): plan from
+            # the nearest stance with one foot moved that has one.
+            for feet in nudged_stances(measured.feet, nudge, start.next_leg):
+                start = PlanStart(feet=feet, next_leg=start.next_leg)
+                plan, tried, wall2 = self._make_plan(start, goal, budget)
+                wall += wall2
+                if plan is not None or "pose certificate" not in tried.reason:
+                    attempt = tried
+                    break
         first = None
         if plan is not None:
             first, wall2 = self._next_step(plan)

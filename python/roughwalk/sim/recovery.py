@@ -45,6 +45,7 @@ __all__ = [
     "pose_segment",
     "min_jerk",
     "off_edge",
+    "standing_feet",
 ]
 
 _RATE_HZ = 100.0
@@ -55,6 +56,9 @@ of its centre, about one radius across) beyond which a lowered foot stands on
 an edge: LittleDog's 1 cm across is steeper than 45°, where no foot holds
 with μ = 1. At 0.5 cm, a catch on a rock's flank (board AC, seed 0 of the
 bench's round rocks: 5.6 mm) moved too, and that run fell."""
+STANDING_M = 0.01
+"""Height [m] of a supporting foot's centre over the ground under it, less
+its radius, within which :func:`standing_feet` takes it to stand."""
 EDGE_STEP_M = 0.0025
 """Step [m] of :func:`off_edge`'s search towards the planned foothold."""
 EDGE_REACH_M = 0.02
@@ -282,6 +286,36 @@ def off_edge(
     return start
 
 
+def standing_feet(
+    robot: Robot,
+    terrain: Terrain,
+    measured: MeasuredState,
+    support: NDArray[np.bool_],
+    loaded_n: float,
+) -> NDArray[np.bool_]:
+    """The feet that bear the trunk while a reflex puts the others down.
+
+    Those loaded, and those supporting and on the ground.
+
+    A foot's measured force alone misses standing feet: on a steep rock
+    face a loaded hind foot chatters (LittleDog board AE, the bench's large
+    rocks seed 0: RH's vertical force alternated 0 and 15–20 N every 8 ms
+    while LH swung), and a trunk sagging onto the other diagonal unloads a
+    front foot (LF) for the instant the reflex fires. Counted as lifted,
+    both were put down with the trunk's whole weight planned on the one
+    loaded foot (RF, 26.6 N), the others unweighted and softened as for a
+    touchdown, and the robot rolled over (34° at 1.41 s, with
+    ``timing.measured_speed`` 0.9). A foot the
+    plan has in ``support`` whose centre is within :data:`STANDING_M` of
+    the ground under it counts as standing, as does any foot bearing more
+    than ``loaded_n`` [N].
+    """
+    loaded = measured.foot_forces[:, 2] > loaded_n
+    ground = terrain.height(measured.feet[:, :2])
+    low = measured.feet[:, 2] - ground - robot.foot_radius < STANDING_M
+    return np.asarray(loaded | (np.asarray(support, dtype=bool) & low), dtype=bool)
+
+
 def recovery_segment(
     robot: Robot,
     terrain: Terrain,
@@ -293,6 +327,7 @@ def recovery_segment(
     ready_at: float,
     press_m: float = 0.0,
     capture_max_m: float = 0.0,
+    bearing: NDArray[np.bool_] | None = None,
 ) -> tuple[list[Segment], NDArray[np.float64]]:
     """The reflex's motion from ``measured``: feet down, trunk over them, hold.
 
@@ -310,6 +345,11 @@ def recovery_segment(
         How far [m] below the terrain surface the lowered feet aim.
     capture_max_m:
         Largest capture offset [m] of a lowered foot (0: straight down).
+    bearing:
+        (4,) the feet that carry the trunk while the others go down
+        (:func:`standing_feet`; default ``in_contact``). A foot both put
+        down and bearing keeps its load as it moves the few millimetres to
+        the ground.
 
     Returns the segments and the four footholds (4, 3) [m] the robot ends on.
     """
@@ -343,9 +383,9 @@ def recovery_segment(
     arch = 0.015 * np.sin(np.pi * s)
     moving = np.linalg.norm(target[:, :2] - start_feet[:, :2], axis=1) > 0.02
     feet[:, moving, 2] += arch[:, None]
-    support = np.asarray(in_contact, dtype=bool)
+    support = np.asarray(in_contact if bearing is None else bearing, dtype=bool)
     segments = []
-    if np.any(~support):
+    if not np.all(in_contact):
         segments.append(
             pose_segment(
                 robot,

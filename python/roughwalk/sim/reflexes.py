@@ -64,11 +64,13 @@ class ReflexMonitor:
         self.config = config if config is not None else ReflexConfig()
         self._since: dict[str, float | None] = dict.fromkeys(_KINDS)
         self._down_since = np.full(4, np.inf)
+        self._short_leg: str | None = None
 
     def reset(self) -> None:
         """Forget persisting errors (after a reflex, or when a new plan starts)."""
         self._since = dict.fromkeys(_KINDS)
         self._down_since[:] = np.inf
+        self._short_leg = None
 
     def errors(
         self, desired: DesiredState, measured: MeasuredState
@@ -120,6 +122,11 @@ class ReflexMonitor:
         for kind, (value, threshold, leg) in self.errors(desired, measured).items():
             if value > threshold:
                 since = self._since[kind]
+                if kind == "foot_force" and self.config.foot_force_per_leg:
+                    # A foot short of load counts from when it, not any foot, fell short.
+                    if leg != self._short_leg:
+                        since = None
+                    self._short_leg = leg
                 if since is None:
                     self._since[kind] = since = now
                 if fired is None and now - since >= self.config.persist_s - 1e-12:
