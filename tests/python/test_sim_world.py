@@ -5,6 +5,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
+from _sim_states import standing_step
 
 import roughwalk
 from roughwalk.errors import ConfigError, InvalidArgumentError
@@ -327,28 +328,10 @@ def test_reflex_fires_only_on_errors_that_persist(littledog) -> None:
     assert fired[25].value == pytest.approx(0.03)
 
 
-def _three_feet_down(robot: roughwalk.Robot) -> object:
-    """The desired state of the nominal stance with LH lifted (LF, RF, RH bear the trunk)."""
-    st = robot.nominal_stance
-    base = np.array([0.5, 0.0, st.base_height])
-    feet = st.feet + base
-    segment = pose_segment(
-        robot,
-        np.array([base, base]),
-        np.zeros((2, 3)),
-        np.array([feet, feet]),
-        np.array([True, True, False, True]),
-        1.0,
-        "hold",
-        0.0,
-    )
-    return segment.sample(0.0)
-
-
 def _foot_force_hits(littledog, per_leg: bool, short_legs) -> list[int]:
     """Ticks at which the foot-force reflex fires; ``short_legs(k)``: the feet unloaded at k."""
     monitor = ReflexMonitor(ReflexConfig(persist_s=0.03, foot_force_per_leg=per_leg))
-    desired = _three_feet_down(littledog)
+    desired = standing_step(littledog, in_contact=(True, True, False, True), kind="hold")
     measured = type("M", (), {})()
     measured.feet = desired.feet.copy()
     measured.base_pos = desired.base_pos.copy()
