@@ -2,36 +2,28 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _learned_models import SHIPPED_PALLET_MODEL, run_one_held_out_task, shipped_pallet_spec
 
 from roughwalk.errors import ConfigError
-from roughwalk.learning import ProblemSpec, build_problem, task_space
-from roughwalk.learning.experience import generate
+from roughwalk.learning import build_problem, task_space
 from roughwalk.learning.initializer import LearnedInitializer, load_model
-from roughwalk.learning.model_constraints import constraints_for_model
 from roughwalk.learning.solution_library import farthest
 from roughwalk.trajopt.optimize import _cheaper
 from roughwalk.trajopt.parameters import SolverOptions
 from roughwalk.trajopt.solver import SolveOutcome, TrajoptStatus
 
-MODEL = "anymal_c_single_pallet_walk16"
+MODEL = SHIPPED_PALLET_MODEL
 # Held-out task 58: the library's pick (and the network's own guess) converge
 # to 3.414, above the task's g_max 3.345; the heuristic reaches 2.559.
 DEAR_TASK = 58
 
 
-def _spec() -> ProblemSpec:
-    model = load_model(MODEL)
-    spec = ProblemSpec("anymal_c", "single_pallet", "walk", 16, 5.5)
-    return replace(spec, constraints=constraints_for_model(model, spec.config().constraints))
-
-
 def test_a_dear_minimum_starts_again_and_keeps_the_cheaper() -> None:
-    problem = build_problem(_spec())
+    problem = build_problem(shipped_pallet_spec())
     initializer = LearnedInitializer(MODEL)
     task = task_space("single_pallet").task(DEAR_TASK, split="test")
     limit = load_model(MODEL).cost_limits([task])
@@ -46,20 +38,8 @@ def test_a_dear_minimum_starts_again_and_keeps_the_cheaper() -> None:
 
 
 def test_experience_runs_from_a_model_start_again_too(tmp_path: Path) -> None:
-    spec = _spec()
     model = load_model(MODEL)
-    data = generate(
-        spec,
-        task_space("single_pallet"),
-        1,
-        tmp_path / "run",
-        split="test",
-        max_iter=100,
-        model=model,
-        init=f"learned:{MODEL}",
-        progress=None,
-        indices=[DEAR_TASK],
-    )
+    data = run_one_held_out_task(tmp_path / "run", DEAR_TASK)
     limit = model.cost_limits([task_space("single_pallet").task(DEAR_TASK, split="test")])
     assert limit is not None
     assert data["status"][0] in ("exact", "approximate")

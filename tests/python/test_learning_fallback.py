@@ -6,25 +6,22 @@ from dataclasses import replace
 from pathlib import Path
 
 import pytest
+from _learned_models import SHIPPED_PALLET_MODEL, run_one_held_out_task, shipped_pallet_spec
 
 from roughwalk.errors import ConfigError
 from roughwalk.learning import ProblemSpec, build_problem, task_space
-from roughwalk.learning.experience import generate
 from roughwalk.learning.initializer import LearnedInitializer, load_model
 from roughwalk.learning.model_constraints import constraints_for_model
 from roughwalk.trajopt.parameters import SolverOptions
 
-MODEL = "anymal_c_single_pallet_walk16"
+MODEL = SHIPPED_PALLET_MODEL
 # Held-out task 104: the shipped model's library pick stops at 100 iterations
 # unconverged; the network's guess converges in 12.
 STUCK_TASK = 104
 
 
 def test_a_stuck_library_pick_restarts_from_the_network_guess_and_converges() -> None:
-    model = load_model(MODEL)
-    spec = ProblemSpec("anymal_c", "single_pallet", "walk", 16, 5.5)
-    spec = replace(spec, constraints=constraints_for_model(model, spec.config().constraints))
-    problem = build_problem(spec)
+    problem = build_problem(shipped_pallet_spec())
     after = problem.config.solver.guess_fallback_after
     assert after is not None
     initializer = LearnedInitializer(MODEL)
@@ -47,25 +44,9 @@ def test_a_stuck_library_pick_restarts_from_the_network_guess_and_converges() ->
 
 
 def test_experience_runs_from_a_model_fall_back_too(tmp_path: Path) -> None:
-    # Held-out runs (bench init, LearnedInit re-solves) hand the model's
-    # guesses over precomputed; the network's guess goes with them.
-    model = load_model(MODEL)
-    spec = ProblemSpec("anymal_c", "single_pallet", "walk", 16, 5.5)
-    spec = replace(spec, constraints=constraints_for_model(model, spec.config().constraints))
-    data = generate(
-        spec,
-        task_space("single_pallet"),
-        1,
-        tmp_path / "run",
-        split="test",
-        max_iter=100,
-        model=model,
-        init=f"learned:{MODEL}",
-        progress=None,
-        indices=[STUCK_TASK],
-    )
+    data = run_one_held_out_task(tmp_path / "run", STUCK_TASK)
     assert data["status"][0] in ("exact", "approximate")
-    assert data["iterations"][0] > _fallback_after(spec)
+    assert data["iterations"][0] > _fallback_after(shipped_pallet_spec())
 
 
 def _fallback_after(spec: ProblemSpec) -> int:
