@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ctypes
+import dataclasses
 import json
 import os
 import time
@@ -414,6 +415,18 @@ def test_bad_tasks_get_a_clear_status(terrain: str, task: tuple, options: dict, 
     assert not result.solved
     assert match in result.message
     assert json.dumps(result.to_dict(), allow_nan=False)
+
+
+def test_the_start_reach_check_accepts_what_the_solver_accepts() -> None:
+    # Task 189's LF foot is 0.019 m beyond its range of motion: refused at the default
+    # constraint tolerance (1e-4 m), tried once the solver itself accepts 0.05 m.
+    task = ((0.49522, 0.317274, -0.387406), (1.6, 0.0, 0.0))
+    cfg = melon_config()
+    loose = dataclasses.replace(cfg, solver=dataclasses.replace(cfg.solver, constr_viol_tol=0.05))
+    refused = optimize_motion("anymal_c", "single_pallet", task, config=cfg, max_iter=0)
+    tried = optimize_motion("anymal_c", "single_pallet", task, config=loose, max_iter=0)
+    assert refused.status is TrajoptStatus.INVALID_INPUT
+    assert tried.status is not TrajoptStatus.INVALID_INPUT, tried.message
 
 
 def test_limits_and_callback_stop_with_their_status() -> None:

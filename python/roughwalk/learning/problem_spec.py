@@ -304,7 +304,10 @@ def task_refusal(spec: ProblemSpec, task: Task) -> str | None:
     can only end infeasible.
     """
     body, terrain = _ground(spec)
-    problems = task_problems(body, terrain, task, tuple(spec.config().constraints))
+    cfg = spec.config()
+    problems = task_problems(
+        body, terrain, task, tuple(cfg.constraints), cfg.solver.constr_viol_tol
+    )
     return "; ".join(problems) if problems else None
 
 

@@ -651,7 +651,9 @@ def optimize_motion(
                     lambda: TerrainModel(terrain_obj, cfg.terrain, cfg.costs.step_edge_sigma),
                 )
     problems = _schedule_problems(schedule, cfg)
-    problems += task_problems(body, terrain_model, the_task, tuple(cfg.constraints))
+    problems += task_problems(
+        body, terrain_model, the_task, tuple(cfg.constraints), cfg.solver.constr_viol_tol
+    )
     if problems:
         return _invalid(
             the_task,

@@ -246,11 +246,14 @@ def level_stance_problems(
 
 
 _LEGS = ("LF", "RF", "LH", "RH")  # the order of SingleRigidBody.stance
-_REACH_TOLERANCE = 1e-4  # [m] the solver's constraint tolerance (``solver.constr_viol_tol``)
 
 
 def start_reach_problems(
-    body: SingleRigidBody, terrain: TerrainModel, pose: tuple[float, float, float], what: str
+    body: SingleRigidBody,
+    terrain: TerrainModel,
+    pose: tuple[float, float, float],
+    what: str,
+    tolerance: float,
 ) -> list[str]:
     """Say which feet of the start stance at ``pose`` lie outside their range of motion.
 
@@ -263,7 +266,8 @@ def start_reach_problems(
     (start (0.495, 0.317, −0.387)) is such a task: its left front foot rests
     0.161 m up the edge, 0.121 m above its nominal height against a reach of
     0.102, and IPOPT ends locally infeasible from every guess, the start
-    rows 0.0187 m off.
+    rows 0.0187 m off. ``tolerance`` [m] is the excess the solver itself
+    accepts (its ``constr_viol_tol``).
     """
     x, y, yaw = pose
     feet, z = nominal_feet(body, terrain, x, y, yaw)
@@ -271,7 +275,7 @@ def start_reach_problems(
     off = (feet - np.array([x, y, z])) @ rot - body.stance  # (4, 3) in the base frame
     excess = np.abs(off) - np.asarray(body.max_deviation)
     out = []
-    for foot in np.flatnonzero(excess.max(axis=1) > _REACH_TOLERANCE):
+    for foot in np.flatnonzero(excess.max(axis=1) > tolerance):
         axis = int(np.argmax(excess[foot]))
         out.append(
             f"{what} ({x:g}, {y:g}, yaw {yaw:g}): the {_LEGS[foot]} foot of its stance is "
@@ -283,7 +287,11 @@ def start_reach_problems(
 
 
 def task_problems(
-    body: SingleRigidBody, terrain: TerrainModel, task: Task, constraints: tuple[str, ...]
+    body: SingleRigidBody,
+    terrain: TerrainModel,
+    task: Task,
+    constraints: tuple[str, ...],
+    tolerance: float,
 ) -> list[str]:
     """Every reason ``task`` cannot be solved on ``terrain`` under ``constraints`` (empty: none).
 
@@ -291,13 +299,14 @@ def task_problems(
     start state and the range of motion both enforced, the start stance's
     reach (:func:`start_reach_problems`); with the goal state too, whether
     a level goal base can stand at all (:func:`level_stance_problems`).
+    ``tolerance`` [m] is the solver's constraint tolerance.
     """
     problems = stance_problems(body, terrain, task.start, "start")
     problems += stance_problems(body, terrain, task.goal, "goal")
     if problems or "range_of_motion" not in constraints:
         return problems
     if "initial_state" in constraints:
-        problems += start_reach_problems(body, terrain, task.start, "start")
+        problems += start_reach_problems(body, terrain, task.start, "start", tolerance)
     if "goal_state" in constraints:
         problems += level_stance_problems(body, terrain, task.goal, "goal")
     return problems
