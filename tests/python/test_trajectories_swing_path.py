@@ -130,6 +130,14 @@ def test_joint_path_is_never_slower_than_the_heuristic(littledog) -> None:
             assert times[1] <= times[0] + 1e-9
 
 
+def test_joint_path_only_under_the_joint_time_law(littledog) -> None:
+    """Under the "even" law (which it does not speed up) the heuristic path is kept."""
+    spline, _ = _swing(littledog, SwingConfig(path="joint"), 0)
+    assert len(spline.waypoints) == 4
+    spline, _ = _swing(littledog, SwingConfig(path="joint", **FAST), 0)
+    assert len(spline.waypoints) == 17
+
+
 def test_joint_path_needs_the_legs_kinematics() -> None:
     """Without the leg's FK the heuristic four-waypoint path is planned."""
     spline = SwingSpline.plan(

@@ -490,7 +490,18 @@ class SwingConfig:
         hip travel per swing 1.31 → 0.94 rad (knee 1.76 → 1.82 rad; apex
         3.3 → 3.9 cm); the shapes cost ~1 s CPU per run (remembered, so a
         footstep is shaped once per trunk pose). With the ``"even"`` law it
-        does not pay (demo 6.49 → 6.23 cm/s, one reflex).
+        does not pay (demo 6.49 → 6.23 cm/s, one reflex), so under other
+        time laws the heuristic path is kept. Boards (``bench_littledog.py
+        --expansions 40000 --seeds 2``; ``timing.measured_speed`` 0.9,
+        ``timing.min_swing_s`` 0.2, ``reflex.standing_bear``,
+        ``reflex.replan_nudge_m`` 0.02, ``reflex.foot_force_per_leg``,
+        ``time_law`` "joint", ``ramp_fraction`` 0.1), "cartesian" →
+        "joint": barrier 5.77 → 6.19 cm/s, steps 6.45 → 7.33, round rocks
+        4.66 → 4.88, sloped rocks 1/2 7.21 → 8.16, gap 5.97 → 6.49, logs
+        4.27 → 5.64, large rocks 3.31 → 3.71; 13 of 14 runs with both. Not
+        the default: the ``"joint"`` law itself, against ``"even"`` with
+        the same settings, is slower on round rocks (5.76), logs (6.08) and
+        large rocks (3.80).
     """
 
     lift_height: float = 0.03

@@ -461,8 +461,9 @@ class SwingSpline:
         start and target. ``leg_angles`` and ``velocity_limit``: for the
         ``"joint"`` time law (see the class).
 
-        With ``config.path == "joint"``, ``leg_angles``, ``velocity_limit``
-        and ``leg_feet`` (the leg's FK at the same trunk pose) the path is
+        With ``config.path == "joint"`` under the ``"joint"`` time law, and
+        ``leg_angles``, ``velocity_limit`` and ``leg_feet`` (the leg's FK at
+        the same trunk pose) given, the path is
         instead shaped in joint space (:func:`_joint_path_waypoints`;
         ``joint_range``: the leg's (lower, upper) angles [rad]), and kept
         where it allows a shorter swing than the heuristic one.
@@ -471,6 +472,7 @@ class SwingSpline:
         t = np.asarray(target, dtype=float)
         if (
             config.path == "joint"
+            and config.time_law == "joint"
             and leg_angles is not None
             and leg_feet is not None
             and velocity_limit is not None
