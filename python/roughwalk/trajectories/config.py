@@ -498,7 +498,8 @@ class SwingConfig:
         ``time_law`` "joint", ``ramp_fraction`` 0.1), "cartesian" →
         "joint": barrier 5.77 → 6.19 cm/s, steps 6.45 → 7.33, round rocks
         4.66 → 4.88, sloped rocks 1/2 7.21 → 8.16, gap 5.97 → 6.49, logs
-        4.27 → 5.64, large rocks 3.31 → 3.71; 13 of 14 runs with both. Not
+        4.27 → 5.64, large rocks 3.31 → 3.71; 13 of 14 runs with both; 1 N·s
+        side pushes at 1.6–3.2 s survived right / left 6 / 7 → 7 / 8 of 9. Not
         the default: the ``"joint"`` law itself, against ``"even"`` with
         the same settings, is slower on round rocks (5.76), logs (6.08) and
         large rocks (3.80).
