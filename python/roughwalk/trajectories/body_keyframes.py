@@ -70,6 +70,20 @@ class BodyKeyframe:
 
         return angles
 
+    def leg_feet(
+        self, wb: WholeBody, leg: int
+    ) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
+        """FK of leg ``leg`` (canonical) from this pose: angles (n, 3) [rad] → feet (n, 3) [m]."""
+        rot = self.rotation
+
+        def feet(angles: NDArray[np.float64]) -> NDArray[np.float64]:
+            a = np.asarray(angles, dtype=float).reshape(-1, 3)
+            q = np.repeat(self.q[None], len(a), axis=0)
+            q[:, leg] = a
+            return self.base_pos + wb.foot_positions(q)[:, leg] @ rot.T
+
+        return feet
+
     def translated(self, wb: WholeBody, shift: ArrayLike) -> BodyKeyframe:
         """The same orientation with the trunk moved by ``shift`` (3,) [m], feet re-solved."""
         return keyframe_at(wb, self.feet, self.base_pos + np.asarray(shift, dtype=float), self.rpy)

@@ -468,6 +468,41 @@ class SwingConfig:
         With ``"even"``: fraction of the swing at each end over which the foot
         speeds up from rest and slows down to rest (peak over mean speed
         1 / (1 − ramp_fraction)). Shorter ramps accelerate harder.
+    path:
+        ``"cartesian"`` (default): the heuristic path above, its lift-off and
+        drop-off at one height over the whole stride. ``"joint"``: the path
+        is shaped in the swing leg's joint space (for the ``"joint"`` time
+        law): the hip (HFE) and knee (KFE) bend by six sine modes each on
+        top of the straight move from the start's angles to the target's,
+        chosen by SLSQP to lower the joints' speed over their limits along
+        the path while the foot keeps ``lift_height`` above the line from
+        start to target and its sphere ``clearance`` above the ground
+        actually under it (both from ``lift_fraction`` of the path in, a
+        share of them on the ramps). The heuristic path lifts the foot
+        straight up, which swings LittleDog's hip (7.5 rad/s against the
+        knee's 14) back and forth: two thirds of its 1.0–1.8 rad per swing.
+        The heuristic path is kept where the shaped one would not allow a
+        shorter swing, or where the leg's kinematics are not given. On a
+        flat 9.5 cm stride: hip travel 1.28 → 0.96 rad, least swing 0.207
+        → 0.172 s (``"joint"`` law, ramps 0.1). Demo (``timing.measured_speed``
+        0.9, ``timing.min_swing_s`` 0.2, ``time_law`` "joint",
+        ``ramp_fraction`` 0.1): 7.27 → 8.19 cm/s, swings 0.278 → 0.241 s,
+        hip travel per swing 1.31 → 0.94 rad (knee 1.76 → 1.82 rad; apex
+        3.3 → 3.9 cm); the shapes cost ~1 s CPU per run (remembered, so a
+        footstep is shaped once per trunk pose). With the ``"even"`` law it
+        does not pay (demo 6.49 → 6.23 cm/s, one reflex), so under other
+        time laws the heuristic path is kept. Boards (``bench_littledog.py
+        --expansions 40000 --seeds 2``; ``timing.measured_speed`` 0.9,
+        ``timing.min_swing_s`` 0.2, ``reflex.standing_bear``,
+        ``reflex.replan_nudge_m`` 0.02, ``reflex.foot_force_per_leg``,
+        ``time_law`` "joint", ``ramp_fraction`` 0.1), "cartesian" →
+        "joint": barrier 5.77 → 6.19 cm/s, steps 6.45 → 7.33, round rocks
+        4.66 → 4.88, sloped rocks 1/2 7.21 → 8.16, gap 5.97 → 6.49, logs
+        4.27 → 5.64, large rocks 3.31 → 3.71; 13 of 14 runs with both; 1 N·s
+        side pushes at 1.6–3.2 s survived right / left 6 / 7 → 7 / 8 of 9. Not
+        the default: the ``"joint"`` law itself, against ``"even"`` with
+        the same settings, is slower on round rocks (5.76), logs (6.08) and
+        large rocks (3.80).
     """
 
     lift_height: float = 0.03
@@ -477,9 +512,12 @@ class SwingConfig:
     time_law: str = "even"
     vertical_weight: float = 1.5
     ramp_fraction: float = 0.2
+    path: str = "cartesian"
 
     def __post_init__(self) -> None:
         _check_nonnegative(self, ("lift_height", "clearance"), "swing")
+        if self.path not in ("cartesian", "joint"):
+            raise ConfigError(f"swing.path must be 'cartesian' or 'joint', got {self.path!r}")
         if not (math.isfinite(self.lift_fraction) and 0 <= self.lift_fraction < 0.5):
             raise ConfigError(f"swing.lift_fraction must be in [0, 0.5), got {self.lift_fraction}")
         if self.time_law not in ("even", "joint", "knots"):

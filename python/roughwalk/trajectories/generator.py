@@ -219,6 +219,8 @@ class FootstepTrajectoryGenerator:
                 self.robot.foot_radius,
                 leg_angles=pose.leg_angles(self.wb, step.leg),
                 velocity_limit=self.wb.velocity_limit[step.leg],
+                leg_feet=pose.leg_feet(self.wb, step.leg),
+                joint_range=(self.wb.lower[step.leg], self.wb.upper[step.leg]),
             )
             path = spline.position(np.linspace(0.0, 1.0, 41))
             trunks = {

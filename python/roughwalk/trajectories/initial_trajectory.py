@@ -308,6 +308,8 @@ def build_initial_trajectory(
         foot_radius=wb.robot.foot_radius,
         leg_angles=swing_pose.leg_angles(wb, step.leg),
         velocity_limit=wb.velocity_limit[step.leg],
+        leg_feet=swing_pose.leg_feet(wb, step.leg),
+        joint_range=(wb.lower[step.leg], wb.upper[step.leg]),
     )
     feet = np.repeat(step.stance_before[None], n + 1, axis=0)
     feet[lift_off : touchdown + 1, step.leg] = swing.position(

@@ -23,12 +23,24 @@ the metric is the leg's own: at each point the largest joint speed over its
 limit, max_j |dq_j/du| / v_j, so the limiting joint runs near its limit along
 the whole path instead of only where the Cartesian metric peaks (the
 velocity-only time-optimal law, smoothed at its ends by the same ramps).
+
+The heuristic path lifts the foot straight up, which on LittleDog swings the
+hip (HFE, 7.5 rad/s) back and forth again while the knee (14 rad/s) bends:
+two thirds of the hip's 1.0–1.8 rad per swing. With ``SwingConfig.path =
+"joint"`` the path is instead shaped in the leg's joint space for the
+``"joint"`` time law: the hip and knee bend by a few sine modes on top of
+the straight move from the start's angles to the target's, chosen to lower
+the joints' speed over their limits along the path while the foot keeps
+``lift_height`` above the line from start to target and ``clearance`` above
+the ground actually under it (not one apex over the whole stride).
 """
 
 from __future__ import annotations
 
+import weakref
+from collections import OrderedDict
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import astuple, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -41,10 +53,12 @@ from roughwalk.trajectories.config import SwingConfig
 if TYPE_CHECKING:
     from roughwalk.terrain.terrain import Terrain
 
-__all__ = ["LegAngles", "SwingSpline", "ramp_profile"]
+__all__ = ["LegAngles", "LegFeet", "SwingSpline", "ground_clearance", "ramp_profile"]
 
 LegAngles = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 """The swing leg's angles (n, 3) [rad] with its foot at world positions (n, 3) [m]."""
+LegFeet = Callable[[NDArray[np.float64]], NDArray[np.float64]]
+"""The swing leg's foot at world positions (n, 3) [m] for its angles (n, 3) [rad]."""
 
 _TABLE = 2001
 """Samples of the path parameter used to invert its arc length."""
@@ -54,6 +68,27 @@ _STOP_SHARE = 0.1
 """Share of the mean weighted speed added to it everywhere (see ``_even_law``)."""
 _JOINT_TABLE = 201
 """Samples of the path at which the "joint" time law evaluates the leg's IK."""
+_PATH_WAYPOINTS = 17
+"""Waypoints of a ``path = "joint"`` swing (about 8 mm apart on a 10 cm stride)."""
+_CHECKS = 33
+"""Samples of the path (ends included) at which a ``path = "joint"`` swing's optimiser
+asks for the clearances (each one constraint: SLSQP's cost grows fast with their number)."""
+_FINE = 97
+"""Samples at which the optimised swing's clearances are checked afterwards."""
+_FOOTPRINT = 4
+"""Points on the foot's rim (plus its centre) at which the ground under it is read."""
+_SHAPES_KEPT = 256
+"""Joint-space swing shapes remembered per terrain (see ``_remembered_shape``)."""
+_MODES = 6
+"""Sine modes of the hip's and the knee's bend along a ``path = "joint"`` swing."""
+_POWER = 8
+"""p of the p-norm over joints that stands in for the largest joint speed over its limit."""
+_ITERATIONS = 60
+"""SLSQP iterations for a ``path = "joint"`` swing's shape."""
+_CUSHION = 0.0015
+"""Margin [m] the optimiser adds to the clearances at its samples, for the path between them."""
+_TOLERANCE = 0.001
+"""Shortfall [m] of a clearance that a ``path = "joint"`` swing may keep between the samples."""
 
 
 def ramp_profile(tau: ArrayLike, ramp: float) -> NDArray[np.float64]:
@@ -77,6 +112,202 @@ def ramp_profile(tau: ArrayLike, ramp: float) -> NDArray[np.float64]:
     late = x > 0.5
     out[late] = 2 * rise(np.array(0.5)) - rise(1.0 - x[late])
     return out * scale
+
+
+def ground_clearance(
+    terrain: Terrain, points: ArrayLike, foot_radius: float
+) -> NDArray[np.float64]:
+    """Height [m] of the foot sphere's bottom above the highest ground under its disc.
+
+    ``points`` (n, 3): foot centres [m]. The ground is read at the centre and
+    ``_FOOTPRINT`` points on the rim (radius ``foot_radius``), a conservative
+    stand-in for the sphere's distance to the terrain.
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    angle = np.linspace(0.0, 2 * np.pi, _FOOTPRINT, endpoint=False)
+    rim = foot_radius * np.stack([np.cos(angle), np.sin(angle)], axis=1)
+    offsets = np.concatenate([np.zeros((1, 2)), rim])
+    xy = (p[:, None, :2] + offsets[None]).reshape(-1, 2)
+    ground = np.asarray(terrain.height(xy), dtype=float).reshape(len(p), -1).max(axis=1)
+    return p[:, 2] - foot_radius - ground
+
+
+def _lift_profile(s: NDArray[np.float64], fraction: float) -> NDArray[np.float64]:
+    """Share (0 → 1 → 0) of the full lift asked for at path fractions ``s``.
+
+    Linear from the ends to ``fraction`` of the path in (the foot leaves and
+    meets the ground at an angle, not sliding along it), 1 between.
+    """
+    f = max(fraction, 0.05)
+    return np.clip(np.minimum(s, 1.0 - s) / f, 0.0, 1.0)
+
+
+def _joint_path_waypoints(
+    start: NDArray[np.float64],
+    target: NDArray[np.float64],
+    config: SwingConfig,
+    terrain: Terrain | None,
+    foot_radius: float,
+    leg_angles: LegAngles,
+    leg_feet: LegFeet,
+    velocity_limit: NDArray[np.float64],
+    joint_range: tuple[NDArray[np.float64], NDArray[np.float64]] | None,
+) -> NDArray[np.float64] | None:
+    """Waypoints (K, 3) [m] of a swing shaped in joint space; or None.
+
+    The leg's angles are q(s) = q₀ + s·(q₁ − q₀) + Σₖ cₖ·sin(kπs), s ∈ [0, 1],
+    the hip (HFE) and knee (KFE) bent by ``_MODES`` sine modes each, the
+    abduction (HAA) straight. The coefficients minimise ∫ ‖q′ / v‖_p ds, a
+    smooth stand-in (p = ``_POWER``) for the largest joint speed over its
+    limit that sets the ``"joint"`` time law's pace (so LittleDog's slow hip
+    moves less and its fast knee lifts), subject to, at ``_CHECKS`` points,
+    the foot being ``lift_height`` above the straight line from start to
+    target and its sphere ``clearance`` above the ground under it
+    (``scan_terrain``), each times :func:`_lift_profile`. The foot is read
+    by FK at the swing pose, its ends shifted onto start and target. None
+    where the optimiser ends short of those clearances by over
+    ``_TOLERANCE`` at ``_FINE`` samples, the angles leave ``joint_range``
+    (lower, upper), or the leg's IK misses the ends by over 2 mm.
+    """
+    from scipy.optimize import minimize
+
+    q0, q1 = np.asarray(leg_angles(np.array([start, target])), dtype=float)
+    ends = np.asarray(leg_feet(np.array([q0, q1])), dtype=float)
+    if np.max(np.linalg.norm(ends - np.array([start, target]), axis=1)) > 0.002:
+        return None
+    modes = np.arange(1, _MODES + 1)
+    at_ends = None
+    if config.scan_terrain and terrain is not None:
+        at_ends = ground_clearance(terrain, np.array([start, target]), foot_radius)
+
+    def margins(s: NDArray[np.float64], cs: NDArray[np.float64]) -> NDArray[np.float64]:
+        """(len(cs), len(s)): the smaller margin [m] of lift and clearance, one FK call."""
+        q = np.repeat((q0 + s[:, None] * (q1 - q0))[None], len(cs), axis=0)
+        basis = np.sin(np.pi * s[:, None] * modes)
+        q[:, :, 1:] += np.einsum("nm,bjm->bnj", basis, cs.reshape(-1, 2, _MODES))
+        p = np.asarray(leg_feet(q.reshape(-1, 3)), dtype=float).reshape(len(cs), len(s), 3)
+        p += (1.0 - s)[:, None] * (start - ends[0]) + s[:, None] * (target - ends[1])
+        share = _lift_profile(s, config.lift_fraction)
+        chord = start[2] + s * (target[2] - start[2])
+        out = p[:, :, 2] - chord - config.lift_height * share
+        if at_ends is not None and terrain is not None:
+            clear = ground_clearance(terrain, p.reshape(-1, 3), foot_radius).reshape(out.shape)
+            # A foot standing on a slope reads its disc's uphill rim above its
+            # sphere's bottom: that shortfall at the ends fades as it lifts.
+            slope = np.minimum(0.0, at_ends[0] + s * (at_ends[1] - at_ends[0]))
+            out = np.minimum(out, clear - slope * (1.0 - share) - config.clearance * share)
+        return out
+
+    s = np.linspace(0.0, 1.0, _CHECKS)[1:-1]
+    rate_basis = np.pi * modes * np.cos(np.pi * s[:, None] * modes)
+    w = 1.0 / np.asarray(velocity_limit, dtype=float).reshape(3)[1:]
+    steady = (q1 - q0)[1:]
+    step = 1e-5
+
+    def cost(c: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+        r = (steady + rate_basis @ c.reshape(2, _MODES).T) * w  # (n, 2)
+        a = np.abs(r) + 1e-12
+        norm = np.sum(a**_POWER, axis=1) ** (1.0 / _POWER)
+        # d‖r‖_p / d r_j = sign(r_j)·(|r_j| / ‖r‖_p)^(p−1)
+        d = np.sign(r) * (a / norm[:, None]) ** (_POWER - 1) * w
+        return float(norm.mean()), (d.T @ rate_basis).ravel() / len(s)
+
+    memo: dict[bytes, NDArray[np.float64]] = {}
+
+    def with_steps(c: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Margins at c and at c plus ``step`` along each coefficient (one FK call)."""
+        key = c.tobytes()
+        if key not in memo:
+            memo.clear()
+            memo[key] = margins(s, np.vstack([c, c + step * np.eye(len(c))]))
+        return memo[key]
+
+    constraints = {
+        "type": "ineq",
+        "fun": lambda c: with_steps(c)[0] - _CUSHION,
+        "jac": lambda c: ((with_steps(c)[1:] - with_steps(c)[0]) / step).T,
+    }
+    # Start from a knee bend that lifts the foot (its sign from FK).
+    mid = 0.5 * (q0 + q1)
+    probe = np.asarray(leg_feet(np.array([mid, mid + [0.0, 0.0, 1e-3]])), dtype=float)
+    guess = np.zeros(2 * _MODES)
+    guess[_MODES] = 0.5 if probe[1, 2] > probe[0, 2] else -0.5
+    result = minimize(
+        cost,
+        guess,
+        jac=True,
+        method="SLSQP",
+        constraints=constraints,
+        options={"maxiter": _ITERATIONS, "ftol": 1e-6},
+    )
+    c = np.asarray(result.x, dtype=float)
+    fine = np.linspace(0.0, 1.0, _FINE)
+    if not np.all(np.isfinite(c)) or np.min(margins(fine[1:-1], c[None])) < -_TOLERANCE:
+        return None
+    q = q0 + fine[:, None] * (q1 - q0)
+    q[:, 1:] += np.sin(np.pi * fine[:, None] * modes) @ c.reshape(2, _MODES).T
+    if joint_range is not None and (
+        np.any(q < joint_range[0] - 1e-9) or np.any(q > joint_range[1] + 1e-9)
+    ):
+        return None
+    p = np.asarray(leg_feet(q), dtype=float)
+    p += (1.0 - fine)[:, None] * (start - ends[0]) + fine[:, None] * (target - ends[1])
+    return p[:: (_FINE - 1) // (_PATH_WAYPOINTS - 1)]
+
+
+_shapes: weakref.WeakKeyDictionary[object, OrderedDict[bytes, NDArray[np.float64] | None]] = (
+    weakref.WeakKeyDictionary()
+)
+_flat_shapes: OrderedDict[bytes, NDArray[np.float64] | None] = OrderedDict()
+
+
+def _remembered_shape(
+    start: NDArray[np.float64],
+    target: NDArray[np.float64],
+    config: SwingConfig,
+    terrain: Terrain | None,
+    foot_radius: float,
+    leg_angles: LegAngles,
+    leg_feet: LegFeet,
+    velocity_limit: NDArray[np.float64],
+    joint_range: tuple[NDArray[np.float64], NDArray[np.float64]] | None,
+) -> NDArray[np.float64] | None:
+    """:func:`_joint_path_waypoints`, remembered: a footstep's swing is shaped several times.
+
+    The same swing is planned for the nominal timing, the fitted timing and
+    each attempt of its trajectory; the shape depends on the ends, the
+    settings, the terrain and the trunk pose, which the leg's FK at three
+    fixed angles pins down. At most ``_SHAPES_KEPT`` shapes per terrain.
+    """
+    probes = np.asarray(leg_feet(np.array([[0.0, 0.0, 0.0], [0.3, 0.5, -0.5], [-0.3, -0.5, 0.5]])))
+    parts = [start, target, probes.ravel(), velocity_limit, [foot_radius]]
+    if joint_range is not None:
+        parts += [joint_range[0], joint_range[1]]
+    key = np.concatenate([np.asarray(x, dtype=float).ravel() for x in parts]).tobytes()
+    key += repr(astuple(config)).encode()
+    if terrain is None:
+        store = _flat_shapes
+    else:
+        store = _shapes.setdefault(terrain, OrderedDict())
+    if key in store:
+        store.move_to_end(key)
+        found = store[key]
+        return None if found is None else found.copy()
+    shape = _joint_path_waypoints(
+        start,
+        target,
+        config,
+        terrain,
+        foot_radius,
+        leg_angles,
+        leg_feet,
+        velocity_limit,
+        joint_range,
+    )
+    store[key] = shape
+    if len(store) > _SHAPES_KEPT:
+        store.popitem(last=False)
+    return None if shape is None else shape.copy()
 
 
 def _interior_slopes(
@@ -218,6 +449,8 @@ class SwingSpline:
         foot_radius: float = 0.0,
         leg_angles: LegAngles | None = None,
         velocity_limit: ArrayLike | None = None,
+        leg_feet: LegFeet | None = None,
+        joint_range: tuple[ArrayLike, ArrayLike] | None = None,
     ) -> SwingSpline:
         """The heuristic lift-off and drop-off points, then the spline.
 
@@ -227,9 +460,49 @@ class SwingSpline:
         the foot's width). They are ``lift_fraction`` of the stride in from
         start and target. ``leg_angles`` and ``velocity_limit``: for the
         ``"joint"`` time law (see the class).
+
+        With ``config.path == "joint"`` under the ``"joint"`` time law, and
+        ``leg_angles``, ``velocity_limit`` and ``leg_feet`` (the leg's FK at
+        the same trunk pose) given, the path is
+        instead shaped in joint space (:func:`_joint_path_waypoints`;
+        ``joint_range``: the leg's (lower, upper) angles [rad]), and kept
+        where it allows a shorter swing than the heuristic one.
         """
         s = np.asarray(start, dtype=float)
         t = np.asarray(target, dtype=float)
+        if (
+            config.path == "joint"
+            and config.time_law == "joint"
+            and leg_angles is not None
+            and leg_feet is not None
+            and velocity_limit is not None
+        ):
+            limit = np.asarray(velocity_limit, dtype=float).reshape(3)
+            limits = None
+            if joint_range is not None:
+                limits = (
+                    np.asarray(joint_range[0], dtype=float).reshape(3),
+                    np.asarray(joint_range[1], dtype=float).reshape(3),
+                )
+            heuristic = cls.plan(
+                s,
+                t,
+                duration,
+                replace(config, path="cartesian"),
+                terrain,
+                foot_radius,
+                leg_angles,
+                limit,
+            )
+            waypoints = _remembered_shape(
+                s, t, config, terrain, foot_radius, leg_angles, leg_feet, limit, limits
+            )
+            if waypoints is None:
+                return heuristic
+            shaped = cls._timed(waypoints, duration, config, leg_angles, limit)
+            # The shape's cost stands in for the time law's pace: keep
+            # whichever path the joints' peak speeds allow the shorter swing.
+            return min((shaped, heuristic), key=lambda c: c.least_time(leg_angles, limit))
         top = max(s[2], t[2]) + config.lift_height
         if config.scan_terrain and terrain is not None:
             stride = float(np.linalg.norm(t[:2] - s[:2]))
@@ -247,6 +520,18 @@ class SwingSpline:
         drop = t - f * (t - s)
         lift[2] = drop[2] = top
         waypoints = np.array([s, lift, drop, t])
+        return cls._timed(waypoints, duration, config, leg_angles, velocity_limit)
+
+    @classmethod
+    def _timed(
+        cls,
+        waypoints: NDArray[np.float64],
+        duration: float,
+        config: SwingConfig,
+        leg_angles: LegAngles | None,
+        velocity_limit: ArrayLike | None,
+    ) -> SwingSpline:
+        """The spline through ``waypoints`` under ``config``'s time law."""
         spline = cls(waypoints, duration, config, leg_angles, velocity_limit)
         if config.time_law != "joint" or leg_angles is None or velocity_limit is None:
             return spline
