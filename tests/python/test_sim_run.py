@@ -115,9 +115,12 @@ OLD_TIMING = {
     "timing.min_shift_s": 0.2,
     "timing.first_shift_s": 0.0,
     "timing.velocity_margin": 1.6,
+    "timing.min_swing_s": 0.3,
+    "timing.measured_speed": 0.0,
 }
-"""The timing defaults until session 9 (the shift's until session 10), which the old
-gaits' push times name."""
+"""The timing defaults until session 9 (the shift's until session 10, the swing's
+floor and the nominal, unmeasured timing until session 12), which the old gaits'
+push times name."""
 
 GAITS = {
     "knots": {"swing.time_law": "knots", "swing.lift_fraction": 0.1, **OLD_TIMING},
@@ -127,7 +130,7 @@ GAITS = {
 
 
 @pytest.mark.parametrize(
-    ("gait", "at_s"), [("knots", 2.0), ("knots", 2.6), ("even", 2.2), ("default", 3.05)]
+    ("gait", "at_s"), [("knots", 2.0), ("knots", 2.6), ("even", 2.2), ("default", 2.95)]
 )
 def test_one_reflex_rescues_a_push_to_the_right_mid_stride(
     littledog, gait: str, at_s: float
@@ -152,7 +155,15 @@ def test_one_reflex_rescues_a_push_to_the_right_mid_stride(
     # no reflex; at 3.05 s, 0.15 s into the swing as before, one reflex
     # rescues it (trunk roll 15°; pushed at 3.0 s it rolls 17°, past this
     # test's 0.3 rad, and still reaches the goal; the sweep from 1.6 to
-    # 3.2 s in 0.2 s steps: only 2.2 s, LF's lift-off, falls).
+    # 3.2 s in 0.2 s steps: only 2.2 s, LF's lift-off, falls). Session 12's
+    # measured timing (timing.measured_speed 0.9, min_swing_s 0.2) puts RF's
+    # swing at 2.79-3.10 s: at 3.05 s the push lands as RF comes down and
+    # fires no reflex; at 2.95 s, 0.16 s into the swing, LH's foot-force
+    # reflex fires and one reflex rescues it (roll 10°, 6.06 cm/s against
+    # 7.04 unpushed). Without reflexes that push (and those at 2.6, 2.8,
+    # 2.9 s) is survived too, rolling 3.5°: the reflex answers a foot
+    # that lost its load, not a fall (the sweep from 1.6 to 3.2 s: 2.2 and
+    # 2.4 s fall, LF's lift-off and swing, with one reflex each).
     terrain = roughwalk.load_terrain("flat")
     push = Push(impulse_ns=1.0, at_s=at_s, direction_deg=-90.0)
     result = walk(
@@ -165,8 +176,9 @@ def test_one_reflex_rescues_a_push_to_the_right_mid_stride(
     assert_walked_to_goal(result)
 
 
-FAST_SWINGS = {"swing.time_law": "joint", "timing.min_swing_s": 0.2}
-"""The faster swings measured in session 10 (not the default): LF's swing spans 2.0 s."""
+FAST_SWINGS = {"swing.time_law": "joint", "timing.min_swing_s": 0.2, "timing.measured_speed": 0.0}
+"""The faster swings measured in session 10 (not the default; nominal timing, as the
+default was until session 12): LF's swing spans 2.0 s."""
 
 
 def test_an_early_reflex_catches_a_push_towards_a_swinging_front_foot(littledog) -> None:
