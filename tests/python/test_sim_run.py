@@ -96,6 +96,10 @@ def test_a_push_beyond_the_threshold_triggers_a_reflex_and_a_replan(littledog) -
     first_reflex = events.index("reflex")
     assert events.index("push") < first_reflex < events.index("replan")
     assert "recovery" in events[first_reflex:]
+    # On flat ground the stance the feet settled on has a certificate: the
+    # re-plan starts there (the event says which start it took).
+    replan = next(e for e in result.log.events if e["kind"] == "replan")
+    assert replan["start"] == "measured"
     assert_walked_to_goal(result)
     # The recovery and the re-plan's stand are the reflex's share of the clock.
     assert result.outcome.extra["time_breakdown"]["reflex_s"] > 0.2
