@@ -397,9 +397,10 @@ class ReflexConfig:
         (3 reflexes, not 2) and logs seed 1 4.01 → 3.52 (barrier 4.73 and
         sloped rocks 1/2 at 5.90 unchanged). On by default since session
         12, with ``standing_bear``, ``replan_nudge_m`` 0.02 and the
-        measured timing (``timing.measured_speed`` 0.9, ``min_swing_s``
+        measured timing (``timing.measured_speed`` 0.95, ``min_swing_s``
         0.2; figures in :class:`~roughwalk.trajectories.config.TimingConfig`):
-        13 of 14 runs as before, large rocks 2/2 at 3.80 cm/s.
+        13 of 14 runs as before, large rocks 2/2 at 4.40 cm/s (3.80 with
+        ``measured_speed`` 0.9).
     settle_max_s:
         Longest extension [s] of the hold for that; then the re-plan starts anyway.
     lower_s:
