@@ -180,8 +180,17 @@ def test_crawl_output_is_consistent(littledog, crawl_result: FootstepTrajectorie
         for i in range(0, len(s.time), 5):
             poly = convex_polygon(s.feet[i][s.support[i]])
             assert polygon_margin(s.zmp[i][None], poly)[0][0] >= -1e-9
+        # The loads carry the weight and the CoM's vertical acceleration
+        # (m·(g + c̈_z)); a swing timed by its joints' peak speeds swings the
+        # leg's mass hard enough at lift-off and touchdown for c̈_z to reach
+        # 5 % of g, so the CoM's own acceleration is checked, not g alone.
         total = s.contact_forces.sum(axis=1)
-        np.testing.assert_allclose(total[:, 2], littledog.mass * 9.81, rtol=0.05)
+        com_vel_z = np.gradient(s.com[:, 2], s.time, edge_order=2)
+        com_acc_z = np.gradient(com_vel_z, s.time, edge_order=2)
+        np.testing.assert_allclose(
+            total[:, 2], littledog.mass * (9.81 + com_acc_z), rtol=0.01, atol=0.05
+        )
+        np.testing.assert_allclose(total[:, 2], littledog.mass * 9.81, rtol=0.1)
         assert np.all(s.contact_forces[~s.support] == 0.0)
         moment = np.einsum(
             "tl,tli->ti", s.contact_forces[..., 2], s.feet[..., :2] - s.zmp[:, None, :]
@@ -229,8 +238,10 @@ def test_swing_timing_under_the_landing_trunk_shortens_a_step_down(littledog) ->
         config = rw.trajectories.trajectory_config(**{"timing.swing_trunk": trunk})
         return FootstepTrajectoryGenerator(littledog, terrain, sdf=sdf, config=config)
 
+    # The nominal guesses (§5.2), before the measured timing
+    # (timing.measured_speed) shortens them to the joints' peak speeds.
     still, landing, shorter = (
-        generator(t).prepare(plan).timings[0] for t in ("still", "landing", "shorter")
+        generator(t).prepare(plan).nominal_timing(0) for t in ("still", "landing", "shorter")
     )
     assert shorter.swing_s == min(still.swing_s, landing.swing_s)
     assert shorter.swing_s < 0.8 * still.swing_s

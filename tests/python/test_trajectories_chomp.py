@@ -340,8 +340,10 @@ def test_objective_decreases_at_every_iteration_on_a_footstep(barrier_state) -> 
         u = np.array(chomp.optimize(xi0, 15, stop_when_feasible=False).objective)
         assert np.all(np.diff(u) < 0), u
         # The body pass drops 22 % with a 0.4 s swing, 18 % with the 0.34 s
-        # that timing.swing_trunk "moving" gives this step.
-        assert u[-1] < 0.85 * u[0]
+        # that timing.swing_trunk "moving" gives this step, and one pass
+        # only 14 % with the 0.30 s that timing.measured_speed 0.95 makes of
+        # it (over 15 % with 0.9's 0.32 s).
+        assert u[-1] < 0.9 * u[0]
 
 
 def test_covariant_update_is_invariant_to_the_number_of_samples() -> None:

@@ -87,8 +87,8 @@ def test_swing_speed_ratio_predicts_the_control_rate_check(crawl, littledog: rw.
 def test_a_hurried_swing_is_lengthened_before_chomp(crawl, littledog: rw.Robot) -> None:
     """Timings 60 % too short: every step is stretched at once and keeps the limits.
 
-    (The "even" swing time law's nominal 0.3 s swings use ~60 % of the
-    velocity limits here, so 40 % too short still keeps them.)
+    (The swings here sit at their 0.2 s floor, ``timing.min_swing_s``, and
+    reach 0.89 of the velocity limits; 60 % shorter, 2.5 times them.)
     """
     gen, prepared = crawl
     hurried = _hurried(prepared, 0.4)

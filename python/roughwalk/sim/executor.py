@@ -557,6 +557,7 @@ class Executor:
             feet=measured.feet.copy(), next_leg=getattr(self, "_reflex_next_leg", None)
         )
         plan, attempt, wall = self._make_plan(start, goal, budget)
+        start_from = "measured"
         planned = getattr(self, "_reflex_planned_feet", None)
         if (
             plan is None
@@ -571,17 +572,24 @@ class Executor:
             start = PlanStart(feet=planned.copy(), next_leg=start.next_leg)
             plan, attempt, wall2 = self._make_plan(start, goal, budget)
             wall += wall2
+            start_from = "planned"
         nudge = self.config.reflex.replan_nudge_m
         if plan is None and "pose certificate" in attempt.reason and nudge > 0:
             # No certificate where the feet stand nor where they were headed
             # (board Y, sloped rocks seed 1: a foot out of reach): plan from
-            # the nearest stance with one foot moved that has one.
+            # the nearest stance with one foot moved that has one. (That run's
+            # first re-plan starts from RF moved 1 cm; its second finds no
+            # stance within 5 cm, nor at the recovery's own footholds.)
+            start_from = f"none within {100 * nudge:.0f} cm"
             for feet in nudged_stances(measured.feet, nudge, start.next_leg):
                 start = PlanStart(feet=feet, next_leg=start.next_leg)
                 plan, tried, wall2 = self._make_plan(start, goal, budget)
                 wall += wall2
                 if plan is not None or "pose certificate" not in tried.reason:
                     attempt = tried
+                    moved = np.linalg.norm((feet - measured.feet)[:, :2], axis=1)
+                    leg = int(np.argmax(moved))
+                    start_from = f"nudged {LEG_NAMES[leg]} {100 * moved[leg]:.0f} cm"
                     break
         first = None
         if plan is not None:
@@ -596,6 +604,7 @@ class Executor:
             wall_s=wall,
             charged_s=charged,
             next_leg=LEG_NAMES[next_leg] if next_leg is not None else None,
+            start=start_from,
             reason=attempt.reason if plan is None else "",
         )
         if plan is None:

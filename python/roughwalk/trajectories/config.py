@@ -130,7 +130,10 @@ class TimingConfig:
         4.4 s), so it stayed 0 until session 10 made it 0.2 with
         ``min_shift_s`` 0.1 (see "Session 10" below).
     min_swing_s:
-        Shortest swing phase [s].
+        Shortest swing phase [s]. 0.2 since session 12 (0.3 before), with
+        ``measured_speed`` 0.95: the measured timing shortens swings only down
+        to this floor, and at 0.3 the floor, not the joints, timed most of
+        them (see ``measured_speed`` for the figures).
     swing_trunk:
         The trunk under which the swing's joint speeds are estimated:
         ``"still"`` holds the swing pose throughout; ``"landing"``
@@ -228,8 +231,11 @@ class TimingConfig:
         Fraction (0 < · ≤ 1) of its velocity limit that each phase's
         fastest joint reaches on the initial trajectory: the nominal timing
         is shortened until it does (never lengthened: that is the re-timing
-        on a broken limit, and restarts). 0 (default) keeps the nominal
-        timing. Session 11, on the demo course (:func:`roughwalk.demo.run_demo`'s
+        on a broken limit, and restarts). 0 keeps the nominal timing.
+        0.95 (with ``min_swing_s`` 0.2 and the three ``reflex`` options
+        ``standing_bear``, ``replan_nudge_m`` 0.02 and ``foot_force_per_leg``)
+        since session 12; 0 (and 0.3, the options off) before. Session 11,
+        on the demo course (:func:`roughwalk.demo.run_demo`'s
         terrain, start and goal, ``executor.plan_expansions`` 40000, no
         computing time charged) with the defaults the swings' fastest joints
         reach 0.72–0.91 of their limits, the shifts' 0.02–0.17, and the
@@ -248,11 +254,37 @@ class TimingConfig:
         cm/s, steps 4.95 → 5.73 → 6.45, round rocks 4.34 → 5.76 → 4.66,
         sloped rocks 1/2 at 5.90 → 6.90 → 7.21 (the same seed fails),
         gap 4.89 → 5.64 → 5.97, logs 4.80 → 6.08 → 5.00, large rocks 2/2
-        at 3.10 → 1/2 at 4.82 → 1/2 at 3.73. Not the default because of
-        that lost run: large rocks seed 0 (board AE), which the defaults
-        survive after two reflexes at 30° of roll, rolls past 34° (at 1.4 s
-        after one reflex; with ``min_swing_s`` 0.3 kept, at 4.6 s after
-        two; with the "joint" law its re-plan finds no start certificate).
+        at 3.10 → 1/2 at 4.82 → 1/2 at 3.73. Not the default in session 11
+        because of that lost run: large rocks seed 0 (board AE), which the
+        defaults survive after two reflexes at 30° of roll, rolls past 34°
+        (at 1.4 s after one reflex; with ``min_swing_s`` 0.3 kept, at 4.6 s
+        after two; with the "joint" law its re-plan finds no start
+        certificate). The three reflex options win it back (see
+        :class:`~roughwalk.sim.config.ReflexConfig`). Session 12, the old
+        defaults → 0.9 with ``min_swing_s`` 0.2 and the three options
+        (the repeatable bench as above): barrier 2/2 at 4.73 → 5.61 cm/s,
+        steps 4.95 → 5.73, round rocks 4.34 → 5.76, sloped rocks 1/2 at
+        5.90 → 6.90 (seed 1 still ends in a re-plan without a certified
+        start), gap 4.89 → 5.64, logs 4.80 → 6.08, large rocks 2/2 at 3.10
+        → 3.80 (seed 0 2.78 cm/s after three reflexes): 13 of 14 runs with
+        both, every class faster; flat ground 0.5 m (``roughwalk run``,
+        2000 expansions) 7.04 cm/s; the 1 N·s side push from 1.6 to 3.2 s
+        (``roughwalk bench push_recovery --from 1.6 --to 3.2 --direction
+        90`` / ``-90``) survives 9 of 9 to the left (8 before) and 7 of 9
+        to the right (8 before, where 2.2 s, LF's lift-off, fell): LF now
+        swings 2.05–2.32 s after the first motion, and the pushes 0.15 s
+        into that swing (2.2 s) and 0.08 s after it lands (2.4 s) roll the
+        trunk over the right feet after one reflex each. 0.9 → 0.95 (same
+        settings otherwise, same commands): 13 of 14 runs, barrier 5.61 →
+        5.83, steps 5.73 → 5.95, round rocks 5.76 → 6.02, sloped rocks 1/2
+        at 6.90 → 7.06, gap 5.64 → 5.86, logs 6.08 → 5.92 (seed 1 after one
+        reflex), large rocks 2/2 at 3.80 → 4.40 (seed 0 after one reflex,
+        not three); demo course 6.49 → 6.81 cm/s (swings 0.317 → 0.299 s);
+        flat 0.5 m 7.04 → 7.38; side push left 9 → 8 of 9, right 7 → 8 of
+        9 (both fall at 2.0 s, 0.07 s into LF's swing; 8 and 8 with the
+        old defaults), hence 0.95. 1.0: demo 6.99 cm/s, large rocks 2/2 at
+        4.56, round rocks 6.13, but the right push survives only 6 of 9
+        (1.8, 2.0, 2.4 s fall) and the left 8.
     max_step_s:
         Longest a step may be made by restarts [s].
     settle_s:
@@ -310,8 +342,8 @@ class TimingConfig:
     shift_travel_m: float = 0.02
     min_hold_s: float = 0.06
     first_shift_s: float = 0.2
-    min_swing_s: float = 0.3
-    measured_speed: float = 0.0
+    min_swing_s: float = 0.2
+    measured_speed: float = 0.95
     max_step_s: float = 4.0
     settle_s: float = 0.8
     swing_trunk: str = "moving"
