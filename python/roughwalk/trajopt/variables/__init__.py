@@ -11,6 +11,8 @@ from roughwalk.trajopt.variables.base_angular import (
     BaseAngular,
     angular_acceleration,
     angular_velocity,
+    body_angular_acceleration,
+    body_angular_velocity,
     euler_rate_matrix,
     euler_to_rotation,
 )
@@ -46,4 +48,6 @@ __all__ = [
     "euler_rate_matrix",
     "angular_velocity",
     "angular_acceleration",
+    "body_angular_velocity",
+    "body_angular_acceleration",
 ]

@@ -24,6 +24,8 @@ __all__ = [
     "euler_rate_matrix",
     "angular_velocity",
     "angular_acceleration",
+    "body_angular_velocity",
+    "body_angular_acceleration",
 ]
 
 
@@ -81,6 +83,45 @@ def angular_velocity(euler: Any, rates: Any) -> Any:
 def angular_acceleration(euler: Any, rates: Any, accelerations: Any) -> Any:
     """World-frame angular acceleration ω̇ [rad/s²] from Euler angles, rates and accelerations."""
     return _euler_rate_matrix_dot(euler, rates) @ rates + euler_rate_matrix(euler) @ accelerations
+
+
+def _body_rate_matrix(euler: Any) -> Any:
+    """E(φ, θ) with ω_body = Rᵀω = E·η̇ for Euler angles ZYX."""
+    cx, sx = _trig(euler[0])
+    cy, sy = _trig(euler[1])
+    rows = [[1.0, 0.0, -sy], [0.0, cx, sx * cy], [0.0, -sx, cx * cy]]
+    if isinstance(euler, ca.SX | ca.MX):
+        return ca.vertcat(*[ca.horzcat(*r) for r in rows])
+    return np.array(rows, dtype=float)
+
+
+def _body_rate_matrix_dot(euler: Any, rates: Any) -> Any:
+    """Ė(φ, θ, φ̇, θ̇)."""
+    cx, sx = _trig(euler[0])
+    cy, sy = _trig(euler[1])
+    xd, yd = rates[0], rates[1]
+    rows = [
+        [0.0, 0.0, -cy * yd],
+        [0.0, -sx * xd, cx * cy * xd - sx * sy * yd],
+        [0.0, -cx * xd, -sx * cy * xd - cx * sy * yd],
+    ]
+    if isinstance(euler, ca.SX | ca.MX):
+        return ca.vertcat(*[ca.horzcat(*r) for r in rows])
+    return np.array(rows, dtype=float)
+
+
+def body_angular_velocity(euler: Any, rates: Any) -> Any:
+    """Body-frame angular velocity Rᵀω [rad/s] from Euler angles and rates."""
+    return _body_rate_matrix(euler) @ rates
+
+
+def body_angular_acceleration(euler: Any, rates: Any, accelerations: Any) -> Any:
+    """Body-frame angular acceleration Rᵀω̇ [rad/s²] from Euler angles, rates and accelerations.
+
+    Rᵀω̇ is the time derivative of Rᵀω (the term Ṙᵀω = −Rᵀ(ω × ω) vanishes),
+    so it is Ė·η̇ + E·η̈.
+    """
+    return _body_rate_matrix_dot(euler, rates) @ rates + _body_rate_matrix(euler) @ accelerations
 
 
 class BaseAngular(NodeVariableSet):
