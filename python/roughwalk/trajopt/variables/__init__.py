@@ -11,10 +11,12 @@ from roughwalk.trajopt.variables.base_angular import (
     BaseAngular,
     angular_acceleration,
     angular_velocity,
+    base_to_world,
     body_angular_acceleration,
     body_angular_velocity,
     euler_rate_matrix,
     euler_to_rotation,
+    world_to_base,
 )
 from roughwalk.trajopt.variables.base_linear import BaseLinear, base_poly_durations
 from roughwalk.trajopt.variables.foot_force import FootForce
@@ -50,4 +52,6 @@ __all__ = [
     "angular_acceleration",
     "body_angular_velocity",
     "body_angular_acceleration",
+    "base_to_world",
+    "world_to_base",
 ]
