@@ -1,4 +1,4 @@
-"""The exact Hessian's cost: the row functions whose curvature IPOPT evaluates every iteration.
+"""What IPOPT's function evaluations cost: the row functions' Hessians, the objective alone.
 
 The dynamics and leg-reach rows are calls of small SX functions whose own
 Hessians are mapped over the samples (see ``formulation._call_hessians``);
@@ -94,3 +94,24 @@ def test_leg_reach_leaves_the_positions_curvature_diagonal(reach_walk: Formulati
     block = ca.hessian(squared(c, eta, foot, o), foot)[0]
     assert block.nnz() == 3
     np.testing.assert_allclose(np.asarray(ca.DM(ca.evalf(block))), 2 * np.eye(3))
+
+
+def _sx_operations(fn: ca.Function) -> int:
+    """Operations of the SX functions an MX function calls (its own MX glue not counted)."""
+    total = 0
+    for i in range(fn.n_instructions()):
+        if fn.instruction_id(i) == ca.OP_CALL:
+            called = fn.instruction_MX(i).which_function()
+            if called.is_a("SXFunction"):
+                total += int(called.n_instructions())
+    return total
+
+
+def test_objective_does_not_compute_the_constraints(reach_walk: Formulation) -> None:
+    # IPOPT evaluates f and g apart (every trial point): an f that came out of
+    # one SX function with g computed all the rows as well.
+    nlp = reach_walk.nlp
+    assert isinstance(nlp, dict)
+    f = ca.Function("f", [nlp["x"], nlp["p"]], [nlp["f"]])
+    g = ca.Function("g", [nlp["x"], nlp["p"]], [nlp["g"]])
+    assert _sx_operations(f) < _sx_operations(g)
