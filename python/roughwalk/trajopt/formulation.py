@@ -508,7 +508,8 @@ class Formulation:
         self.nlp = {
             "x": x_mx,
             "p": p_mx,
-            "f": objective(x_mx, p_mx, t_mx),
+            # Dense: a cost-free problem (TOWR's) still has a number for f.
+            "f": ca.densify(objective(x_mx, p_mx, t_mx)),
             "g": constraints(x_mx, p_mx, t_mx),
         }
         self.evaluator = ca.Function("evaluate", [x_mx, p_mx], [f_mx, g_mx, c_mx])
