@@ -11,7 +11,7 @@ import casadi as ca
 import numpy as np
 
 from roughwalk.trajopt.constraints import Constraint, Rows, register, stack_calls
-from roughwalk.trajopt.variables import euler_to_rotation, sample_points
+from roughwalk.trajopt.variables import sample_points, world_to_base
 
 if TYPE_CHECKING:
     from roughwalk.trajopt.formulation import Formulation
@@ -26,9 +26,8 @@ class RangeOfMotion(Constraint):
     def build(self, nlp: Formulation) -> Rows | None:
         """Three rows per foot and sample time."""
         c, eta, foot = ca.SX.sym("c", 3), ca.SX.sym("eta", 3), ca.SX.sym("p", 3)
-        in_base = ca.Function(
-            "foot_in_base", [c, eta, foot], [euler_to_rotation(eta).T @ (foot - c)]
-        )
+        # Rᵀ(p − c) as three turns: a third fewer operations in the exact Hessian.
+        in_base = ca.Function("foot_in_base", [c, eta, foot], [world_to_base(eta, foot - c)])
         stance = nlp.body.stance
         dev = np.asarray(nlp.body.max_deviation)
         times = nlp.sample_times(nlp.config.dt_range_of_motion)

@@ -11,8 +11,12 @@ from roughwalk.trajopt.variables.base_angular import (
     BaseAngular,
     angular_acceleration,
     angular_velocity,
+    base_to_world,
+    body_angular_acceleration,
+    body_angular_velocity,
     euler_rate_matrix,
     euler_to_rotation,
+    world_to_base,
 )
 from roughwalk.trajopt.variables.base_linear import BaseLinear, base_poly_durations
 from roughwalk.trajopt.variables.foot_force import FootForce
@@ -46,4 +50,8 @@ __all__ = [
     "euler_rate_matrix",
     "angular_velocity",
     "angular_acceleration",
+    "body_angular_velocity",
+    "body_angular_acceleration",
+    "base_to_world",
+    "world_to_base",
 ]
