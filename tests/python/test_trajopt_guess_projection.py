@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from _trajopt_problems import pallet_edge_climb
 
-from roughwalk.errors import ConfigError
+from roughwalk.errors import ConfigError, PlanningError
 from roughwalk.terrain import load_terrain
 from roughwalk.trajopt import (
     TOWR_ANYMAL,
@@ -121,3 +121,31 @@ def test_optimize_motion_projects_the_guess_when_asked() -> None:
     assert before["dynamics"] > 10.0
     assert after["dynamics"] < 0.1 * before["dynamics"]
     assert after["force"] < 1.0
+
+
+def test_left_out_rows_keep_the_guess_s_violation(
+    flat_walk: tuple[Formulation, np.ndarray, np.ndarray],
+) -> None:
+    # A guess that starts 5 cm ahead of the task's start: projected, it starts
+    # there; with initial_state left out it keeps its own start.
+    nlp, x0, p = flat_walk
+    parts = nlp.split(x0)
+    base = nlp.base_lin
+    pos, vel = base.unpack(parts[base.name])
+    pos[:, 0] += 0.05
+    parts[base.name] = base.pack(pos, vel)
+    shifted = nlp.join(parts)
+    assert _violation(nlp, shifted, p, "initial_state") > 0.04
+    moved = project_guess(nlp, shifted, p, GuessProjection(steps=1))
+    kept = project_guess(nlp, shifted, p, GuessProjection(steps=1, left_out=("initial_state",)))
+    assert _violation(nlp, moved, p, "initial_state") < 0.005
+    assert _violation(nlp, kept, p, "initial_state") > 0.04
+    assert _violation(nlp, kept, p, "force_between_nodes") < 1.0
+
+
+def test_an_unknown_left_out_name_is_refused(
+    flat_walk: tuple[Formulation, np.ndarray, np.ndarray],
+) -> None:
+    nlp, x0, p = flat_walk
+    with pytest.raises(PlanningError, match="'initial_stat'.*initial_state"):
+        project_guess(nlp, x0, p, GuessProjection(steps=1, left_out=("initial_stat",)))

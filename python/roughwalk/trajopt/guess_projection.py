@@ -161,6 +161,14 @@ def project_guess(
         # Row j in step units: divide by its gradient's σ-weighted norm.
         norms = np.sqrt(np.asarray(jac.multiply(jac) @ (sigma**2)).ravel())
         live = norms > 1e-12
+        slices = nlp.row_slices()
+        for name in settings.left_out:
+            if name not in slices:
+                raise PlanningError(
+                    f"guess_projection.left_out names {name!r}, not a constraint of this NLP; "
+                    f"its constraints: {', '.join(slices)}"
+                )
+            live[slices[name]] = False
         scale = np.where(live, 1.0 / np.where(live, norms, 1.0), 0.0)
         a = sp.diags(scale) @ jac @ sp.diags(sigma)  # in u = (x − xₖ)/σ
         with np.errstate(invalid="ignore"):  # ±inf bounds of rows without a gradient

@@ -461,6 +461,9 @@ class GuessProjection:
         ρ: the cost of a unit of violation of a row (in the step's σ units)
         against one unit of step. Large is nearly hard; the slack only keeps
         the programme feasible where linearised rows contradict each other.
+    left_out:
+        Names of the NLP's constraints the projection does not move onto
+        (their rows are left as the guess has them).
     tolerance:
         The QP solver's absolute tolerance (in σ units): coarser is faster;
         the next IPOPT iteration (or the controller) needs no more.
@@ -479,11 +482,12 @@ class GuessProjection:
     duration_s: float = 0.01
     row_weight: float = 1e4
     tolerance: float = 1e-4
+    left_out: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if not (isinstance(self.steps, int) and self.steps >= 0):
             raise ConfigError(f"guess_projection.steps must be an integer ≥ 0, got {self.steps!r}")
-        for name in tuple(self.__dataclass_fields__)[2:]:
+        for name in tuple(self.__dataclass_fields__)[2:-1]:
             v = getattr(self, name)
             if not v > 0:
                 raise ConfigError(f"guess_projection.{name} must be > 0, got {v!r}")
