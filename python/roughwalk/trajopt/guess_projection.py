@@ -24,6 +24,25 @@ units as the step; ρ is large (nearly hard rows), and the slacks keep the
 programme feasible where linearised rows contradict each other. σ says
 which variables should give: forces and their rates much more than the
 base and feet. The rows are linearised again at each step's result.
+
+Off by default (``GuessProjection.steps`` 0): it does not make the double
+pallet's plans track more often. Measured on held-out tasks 0–29
+(``bench_tracking.py --tasks 30 --env double_pallet --init learned
+--durations fixed --iters 0,5 --trajopt guess_projection.steps=1,...``,
+paired with the same command without it, 21/30 at 0 and 5 iterations, load
+8–13): with the default σ, 8/20 against 17/20 at 0 iterations (the
+projection moves each plan to its task's start, which the learned guesses
+miss by a median 32 cm, and drags the trunk into rolls of ±1.7 rad/s); with
+the trunk and feet held (σ 2 mm, 0.5 mrad, 1 mm) and ``initial_state``
+left out, the forces alone give way and the plans keep the pyramid at the
+force nodes and between them — see docs/measurements.md, session 12, for
+the paired counts. One step is not a projection there, though: on tasks
+0–3 it takes the pyramid rows (force 7–161 → 17–50 N, unilaterality between
+nodes 12–333 → 1.5–7.6 N) but not the dynamics (4–68 → 32–167 N: the
+torque rows are bilinear, and the bases on the smoothed pallet edge, tilted
+75–82°, move with the footholds). The controller weighs the planned forces
+at 10⁻⁴ (a preference); what it must realise is the base motion, which
+this does not make more feasible. More steps, damped, are untried.
 """
 
 from __future__ import annotations
