@@ -22,6 +22,7 @@ from roughwalk.trajopt.initializers import (
 from roughwalk.trajopt.optimize import TrajoptProblem, clear_cache, optimize_motion
 from roughwalk.trajopt.parameters import (
     CostWeights,
+    GuessProjection,
     IntegralCost,
     SolverOptions,
     TerrainModelConfig,
@@ -50,6 +51,7 @@ __all__ = [
     "parse_pose",
     "TrajoptConfig",
     "CostWeights",
+    "GuessProjection",
     "IntegralCost",
     "SolverOptions",
     "TerrainModelConfig",

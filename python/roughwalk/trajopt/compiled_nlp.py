@@ -110,13 +110,14 @@ def structure_digest(
     (iteration and time limits, IPOPT's options) change how the functions are
     solved, not the functions, and a solve with ``--max-iter`` (or ``roughwalk
     cache warm``, which takes no iteration) must find the entry of the same
-    structure. Nor are ``init`` (where the first guess comes from) and
+    structure. Nor are ``init`` (where the first guess comes from),
+    ``guess_projection`` (how it is moved before the solve) and
     ``sample_rate_hz`` (how the result is sampled): heuristic and learned solves
     of one structure share its entry. ``kind`` is "compiled" (here) or "serialized"
     (:mod:`.serialized_nlp`): the two kinds of one structure are separate entries.
     """
     described = to_dict(config)
-    for unused in ("compiled", "init", "sample_rate_hz"):
+    for unused in ("compiled", "init", "sample_rate_hz", "guess_projection"):
         described.pop(unused, None)
     described["solver"] = {"hessian": described["solver"]["hessian"]}
     description = {

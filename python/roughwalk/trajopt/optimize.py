@@ -26,6 +26,7 @@ from roughwalk.terrain import Terrain, load_terrain
 from roughwalk.trajopt import compiled_nlp, serialized_nlp
 from roughwalk.trajopt.formulation import Formulation
 from roughwalk.trajopt.gaits import ContactSchedule, make_gait
+from roughwalk.trajopt.guess_projection import project_guess
 from roughwalk.trajopt.initializers import Initializer, make_initializer
 from roughwalk.trajopt.parameters import SolverOptions, TrajoptConfig, melon_config
 from roughwalk.trajopt.result import Splines, TrajoptResult
@@ -189,6 +190,9 @@ class TrajoptProblem:
         if warm_start is None:
             guessed = time.perf_counter()
             x0 = initializer.guess(nlp, resolved)
+            # Onto the linearised rows first, when asked: a guess stopped after
+            # 0–5 iterations is what the controller executes.
+            x0 = project_guess(nlp, x0, resolved.vector(), self.config.guess_projection)
             # A guess that comes with multipliers (the learned one) warm-starts IPOPT.
             multipliers = getattr(initializer, "multipliers", None)
             if multipliers is not None:

@@ -25,6 +25,7 @@ __all__ = [
     "CostWeights",
     "TerrainModelConfig",
     "SolverOptions",
+    "GuessProjection",
     "TrajoptConfig",
     "TOWR_CONSTRAINTS",
     "MELON_CONSTRAINTS",
@@ -439,6 +440,63 @@ class SolverOptions:
 
 
 @dataclass(frozen=True)
+class GuessProjection:
+    """Moving the initial guess onto the linearised rows before IPOPT (:mod:`.guess_projection`).
+
+    Attributes
+    ----------
+    steps:
+        Gauss–Newton projection steps (0: IPOPT starts from the guess as
+        made). Each costs one constraint Jacobian and one sparse QP (on the
+        16-step double-pallet walk 1.5–2.7 s of CPU, mostly proxqp's). 0 by default:
+        on 30 held-out double-pallet tasks it tracked no more often (session
+        12, docs/measurements.md).
+    between_nodes:
+        Also keep the forces unilateral and inside the friction pyramid at
+        the inner Bézier control points of every stance force segment (the
+        rows of ``force_between_nodes``), whether or not the NLP has them.
+    base_position_m, base_velocity_m_s, base_angle_rad, base_rate_rad_s,
+    foot_position_m, foot_velocity_m_s, force_n, force_rate_n_s, duration_s:
+        σ of each kind of variable: how far [its unit] it moves for one unit
+        of cost. Small σ keeps that part of the guess; large σ lets it give
+        way. The forces, the guess's worst part, give way most.
+    row_weight:
+        ρ: the cost of a unit of violation of a row (in the step's σ units)
+        against one unit of step. Large is nearly hard; the slack only keeps
+        the programme feasible where linearised rows contradict each other.
+    left_out:
+        Names of the NLP's constraints the projection does not move onto
+        (their rows are left as the guess has them).
+    tolerance:
+        The QP solver's absolute tolerance (in σ units): coarser is faster;
+        the next IPOPT iteration (or the controller) needs no more.
+    """
+
+    steps: int = 0
+    between_nodes: bool = True
+    base_position_m: float = 0.01
+    base_velocity_m_s: float = 0.05
+    base_angle_rad: float = 0.01
+    base_rate_rad_s: float = 0.05
+    foot_position_m: float = 0.005
+    foot_velocity_m_s: float = 0.05
+    force_n: float = 50.0
+    force_rate_n_s: float = 500.0
+    duration_s: float = 0.01
+    row_weight: float = 1e4
+    tolerance: float = 1e-4
+    left_out: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.steps, int) and self.steps >= 0):
+            raise ConfigError(f"guess_projection.steps must be an integer ≥ 0, got {self.steps!r}")
+        for name in tuple(self.__dataclass_fields__)[2:-1]:
+            v = getattr(self, name)
+            if not v > 0:
+                raise ConfigError(f"guess_projection.{name} must be > 0, got {v!r}")
+
+
+@dataclass(frozen=True)
 class TrajoptConfig:
     """Everything that defines the NLP and its solve (TOWR's ``Parameters`` and more).
 
@@ -495,6 +553,9 @@ class TrajoptConfig:
         Terrain smoothing (:class:`TerrainModelConfig`).
     solver:
         IPOPT settings and limits (:class:`SolverOptions`).
+    guess_projection:
+        Whether and how the initial guess is moved onto the linearised
+        constraints before IPOPT starts (:class:`GuessProjection`).
     sample_rate_hz:
         Rate [Hz] at which results sample the trajectories for JSON output.
     compiled:
@@ -530,6 +591,7 @@ class TrajoptConfig:
     init: str = "heuristic"
     terrain: TerrainModelConfig = field(default_factory=TerrainModelConfig)
     solver: SolverOptions = field(default_factory=SolverOptions)
+    guess_projection: GuessProjection = field(default_factory=GuessProjection)
     sample_rate_hz: float = 100.0
     compiled: str = "off"
 
@@ -575,6 +637,7 @@ class TrajoptConfig:
                 "swing_clearance",
                 "base_clearance",
                 "terrain",
+                "guess_projection",
             )
         ) + (
             self.solver.hessian,
