@@ -101,3 +101,19 @@ def test_pyramid_violation_sees_a_stance_force_outside_the_cone_between_nodes() 
     assert bench.pyramid_violation(result) == pytest.approx(30.0)
     contact[200, 0] = False  # in swing the force is not the ground's
     assert bench.pyramid_violation(result) == pytest.approx(20.0)
+
+
+def test_start_offset_says_how_far_a_plan_starts_from_its_task() -> None:
+    bench = load_benchmark("bench_tracking")
+    plan = {"base_position": np.array([[0.3, -0.4, 0.5]]), "base_euler": np.array([[0, 0, 3.0]])}
+    result = SimpleNamespace(sample=lambda rate_hz=None, times=None: plan)
+    offset, dyaw = bench.start_offset(result, (0.0, 0.0, -3.0))
+    assert offset == pytest.approx(0.5)
+    assert dyaw == pytest.approx(2 * np.pi - 6.0)  # the short way round
+    rows = [
+        {"env": "e", "init": "i", "optimize_durations": False, "max_iter": 0, "start_offset_m": o}
+        for o in (0.01, 0.32, 0.2)
+    ]
+    summary = bench.summarise(rows)[0]
+    assert summary["off_start"] == 2
+    assert summary["median_start_offset_m"] == pytest.approx(0.2)
