@@ -37,6 +37,13 @@ def _trig(x: Any) -> tuple[Any, Any]:
     return np.cos(x), np.sin(x)
 
 
+def _matrix(rows: list[list[Any]], euler: Any) -> Any:
+    """``rows`` as a CasADi matrix where ``euler`` is symbolic, else as a numpy array."""
+    if isinstance(euler, ca.SX | ca.MX):
+        return ca.vertcat(*[ca.horzcat(*r) for r in rows])
+    return np.array(rows, dtype=float)
+
+
 def euler_to_rotation(euler: Any) -> Any:
     """Base-to-world rotation R = R_z(ψ) R_y(θ) R_x(φ) for η = (φ, θ, ψ) [rad]."""
     cx, sx = _trig(euler[0])
@@ -47,9 +54,7 @@ def euler_to_rotation(euler: Any) -> Any:
         [cy * sz, cx * cz + sx * sy * sz, cx * sy * sz - cz * sx],
         [-sy, cy * sx, cx * cy],
     ]
-    if isinstance(euler, ca.SX | ca.MX):
-        return ca.vertcat(*[ca.horzcat(*r) for r in rows])
-    return np.array(rows, dtype=float)
+    return _matrix(rows, euler)
 
 
 def _vector(*entries: Any) -> Any:
@@ -87,9 +92,7 @@ def euler_rate_matrix(euler: Any) -> Any:
     cy, sy = _trig(euler[1])
     cz, sz = _trig(euler[2])
     rows = [[cy * cz, -sz, 0.0], [cy * sz, cz, 0.0], [-sy, 0.0, 1.0]]
-    if isinstance(euler, ca.SX | ca.MX):
-        return ca.vertcat(*[ca.horzcat(*r) for r in rows])
-    return np.array(rows, dtype=float)
+    return _matrix(rows, euler)
 
 
 def _euler_rate_matrix_dot(euler: Any, rates: Any) -> Any:
@@ -102,9 +105,7 @@ def _euler_rate_matrix_dot(euler: Any, rates: Any) -> Any:
         [cy * cz * zd - sy * sz * yd, -sz * zd, 0.0],
         [-cy * yd, 0.0, 0.0],
     ]
-    if isinstance(euler, ca.SX | ca.MX):
-        return ca.vertcat(*[ca.horzcat(*r) for r in rows])
-    return np.array(rows, dtype=float)
+    return _matrix(rows, euler)
 
 
 def angular_velocity(euler: Any, rates: Any) -> Any:
@@ -122,9 +123,7 @@ def _body_rate_matrix(euler: Any) -> Any:
     cx, sx = _trig(euler[0])
     cy, sy = _trig(euler[1])
     rows = [[1.0, 0.0, -sy], [0.0, cx, sx * cy], [0.0, -sx, cx * cy]]
-    if isinstance(euler, ca.SX | ca.MX):
-        return ca.vertcat(*[ca.horzcat(*r) for r in rows])
-    return np.array(rows, dtype=float)
+    return _matrix(rows, euler)
 
 
 def _body_rate_matrix_dot(euler: Any, rates: Any) -> Any:
@@ -137,9 +136,7 @@ def _body_rate_matrix_dot(euler: Any, rates: Any) -> Any:
         [0.0, -sx * xd, cx * cy * xd - sx * sy * yd],
         [0.0, -cx * xd, -sx * cy * xd - cx * sy * yd],
     ]
-    if isinstance(euler, ca.SX | ca.MX):
-        return ca.vertcat(*[ca.horzcat(*r) for r in rows])
-    return np.array(rows, dtype=float)
+    return _matrix(rows, euler)
 
 
 def body_angular_velocity(euler: Any, rates: Any) -> Any:
