@@ -282,3 +282,44 @@ def test_config_refuses_nonsense() -> None:
     )
     assert cfg.chomp.max_iterations == 7 and cfg.zmp.shortcut is False
     assert isinstance(cfg, TrajectoryConfig)
+
+
+def test_joint_time_law_does_not_dash_where_the_leg_misses_its_path() -> None:
+    # A downhill swing planned at the swing pose, whose leg does not reach the
+    # target 3 cm down (LittleDog board AC): the clamped IK stops there, its
+    # rate reads zero, and the law dashed through the drop, which the trunk,
+    # lowered by the time the foot lands, follows at joint speeds 21 % over
+    # the "even" law's. With the leg's FK the law sees the miss and is "even";
+    # where the leg reaches its path, FK changes nothing.
+    from roughwalk.trajectories.body_keyframes import keyframe_at
+    from roughwalk.trajectories.whole_body import WholeBody
+
+    robot = rw.load_robot("littledog")
+    wb = WholeBody(robot)
+    leg, stride, drop = 0, 0.08, 0.03
+    feet = robot.nominal_stance.feet.copy()
+    feet[:, 2] = robot.foot_radius
+    feet[leg, 0] -= stride / 2
+    base = np.array([0.0, 0.0, robot.nominal_stance.base_height])
+    high = keyframe_at(wb, feet, base, np.zeros(3))
+    low = keyframe_at(wb, feet, base - [0.0, 0.0, drop], np.zeros(3))
+    start = feet[leg].copy()
+    target = start + [stride, 0.0, -drop]
+    limit = wb.velocity_limit[leg]
+
+    def least_time(law: str, pose, landed) -> float:
+        spline = SwingSpline.plan(
+            start,
+            target,
+            1.0,
+            SwingConfig(time_law=law, ramp_fraction=0.1),
+            leg_angles=pose.leg_angles(wb, leg),
+            velocity_limit=limit,
+            leg_feet=pose.leg_feet(wb, leg),
+        )
+        return spline.least_time(landed.leg_angles(wb, leg), limit)
+
+    missed = high.leg_feet(wb, leg)(high.leg_angles(wb, leg)(target[None]))[0]
+    assert np.linalg.norm(missed - target) > 0.01
+    assert least_time("joint", high, low) <= 1.01 * least_time("even", high, low)
+    assert least_time("joint", low, low) < 0.9 * least_time("even", low, low)

@@ -68,6 +68,8 @@ _STOP_SHARE = 0.1
 """Share of the mean weighted speed added to it everywhere (see ``_even_law``)."""
 _JOINT_TABLE = 201
 """Samples of the path at which the "joint" time law evaluates the leg's IK."""
+_REACH_TOLERANCE = 0.002
+"""Miss [m] of the leg's IK beyond which the "joint" law does not trust its rate."""
 _PATH_WAYPOINTS = 17
 """Waypoints of a ``path = "joint"`` swing (about 8 mm apart on a 10 cm stride)."""
 _CHECKS = 33
@@ -347,6 +349,14 @@ class SwingSpline:
         The swing leg's IK (:data:`LegAngles`) and its joints' limits (3,)
         [rad/s], for ``time_law == "joint"``; without them that law falls
         back to ``"even"``.
+    leg_feet:
+        The leg's FK at the same trunk pose (:data:`LegFeet`). With it, the
+        ``"joint"`` law is ``"even"`` where the IK misses the path by over
+        ``_REACH_TOLERANCE`` (a target below the leg's reach from the swing
+        pose): the clamped angles stop there, the leg's rate reads zero and
+        the law dashed through that stretch, which the trunk's later pose
+        then has to follow at up to 1.5 times the joints' limits (LittleDog
+        board AC, the last fifth of a downhill swing).
 
     Attributes
     ----------
@@ -361,6 +371,7 @@ class SwingSpline:
         config: SwingConfig | None = None,
         leg_angles: LegAngles | None = None,
         velocity_limit: ArrayLike | None = None,
+        leg_feet: LegFeet | None = None,
     ) -> None:
         p = np.asarray(waypoints, dtype=float)
         if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 2 or not np.all(np.isfinite(p)):
@@ -380,6 +391,12 @@ class SwingSpline:
         joint_metric = None
         if leg_angles is not None and velocity_limit is not None:
             joint_metric = (leg_angles, np.asarray(velocity_limit, dtype=float).reshape(3))
+        if (
+            joint_metric is not None
+            and leg_feet is not None
+            and not self._reached(joint_metric[0], leg_feet)
+        ):
+            joint_metric = None
         if config is not None and config.time_law in ("even", "joint"):
             self._law = self._even_law(
                 config.vertical_weight,
@@ -388,6 +405,12 @@ class SwingSpline:
             )
             if self._law is not None:
                 self.times = self._pass_times()
+
+    def _reached(self, leg_angles: LegAngles, leg_feet: LegFeet) -> bool:
+        """Whether the leg's IK puts its foot on the path (within ``_REACH_TOLERANCE``)."""
+        points, _, _ = self._evaluate_path(np.linspace(0.0, self.duration, _JOINT_TABLE))
+        feet = np.asarray(leg_feet(np.asarray(leg_angles(points), dtype=float)), dtype=float)
+        return bool(np.max(np.linalg.norm(feet - points, axis=1)) <= _REACH_TOLERANCE)
 
     def _even_law(
         self,
@@ -493,13 +516,14 @@ class SwingSpline:
                 foot_radius,
                 leg_angles,
                 limit,
+                leg_feet=leg_feet,
             )
             waypoints = _remembered_shape(
                 s, t, config, terrain, foot_radius, leg_angles, leg_feet, limit, limits
             )
             if waypoints is None:
                 return heuristic
-            shaped = cls._timed(waypoints, duration, config, leg_angles, limit)
+            shaped = cls._timed(waypoints, duration, config, leg_angles, limit, leg_feet)
             # The shape's cost stands in for the time law's pace: keep
             # whichever path the joints' peak speeds allow the shorter swing.
             return min((shaped, heuristic), key=lambda c: c.least_time(leg_angles, limit))
@@ -520,7 +544,7 @@ class SwingSpline:
         drop = t - f * (t - s)
         lift[2] = drop[2] = top
         waypoints = np.array([s, lift, drop, t])
-        return cls._timed(waypoints, duration, config, leg_angles, velocity_limit)
+        return cls._timed(waypoints, duration, config, leg_angles, velocity_limit, leg_feet)
 
     @classmethod
     def _timed(
@@ -530,9 +554,10 @@ class SwingSpline:
         config: SwingConfig,
         leg_angles: LegAngles | None,
         velocity_limit: ArrayLike | None,
+        leg_feet: LegFeet | None = None,
     ) -> SwingSpline:
         """The spline through ``waypoints`` under ``config``'s time law."""
-        spline = cls(waypoints, duration, config, leg_angles, velocity_limit)
+        spline = cls(waypoints, duration, config, leg_angles, velocity_limit, leg_feet)
         if config.time_law != "joint" or leg_angles is None or velocity_limit is None:
             return spline
         # Where the leg's IK is nearly singular along the path (a high swing
