@@ -358,9 +358,15 @@ impl FootstepModel {
         let search = self.certificate_search();
         let cfg = &self.config.certificate;
         let full = cfg.clearance + self.sdf_error;
-        [full, cfg.start_clearance.min(full)]
-            .into_iter()
-            .find_map(|required| {
+        let relaxed = cfg.start_clearance.min(full);
+        let asked: &[f64] = if relaxed < full {
+            &[full, relaxed]
+        } else {
+            &[full]
+        };
+        asked
+            .iter()
+            .find_map(|&required| {
                 search
                     .find_from(&centres, &contacts, &support, trunk, required)
                     .ok()
