@@ -304,8 +304,14 @@ class FootstepPlanner:
         expansions: int | None = None,
         callback: Callable[[dict[str, Any]], Any] | None = None,
         search: str = "arastar",
+        start_trunk: tuple[ArrayLike, ArrayLike] | None = None,
     ) -> dict[str, Any]:
-        """Plan from a trunk pose or from feet (4, 2) [m] to the disc around ``goal`` [m]."""
+        """Plan from a trunk pose or from feet (4, 2) [m] to the disc around ``goal`` [m].
+
+        ``start_trunk`` (with ``start_feet`` only): the measured trunk position [m]
+        and quaternion (w, x, y, z) a start certificate is searched from where the
+        pose guessed from the feet has none.
+        """
     @property
     def lattice(self) -> tuple[float, float, float, int, int]:
         """(x0, y0, resolution, nx, ny) of the foothold lattice [m, m, m, -, -]."""

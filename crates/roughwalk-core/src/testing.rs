@@ -180,6 +180,7 @@ pub fn test_config() -> FootstepConfig {
             max_turn: 0.15,
             max_drift: 0.5 * l,
             clearance: 0.004,
+            start_clearance: 0.0,
             clearance_overshoot: 0.002,
             preferred_clearance: 0.01,
             clearance_penalty: 0.5,

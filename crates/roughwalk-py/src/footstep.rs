@@ -18,6 +18,7 @@ use roughwalk_core::footstep::{
     FootstepPlanner, FootstepRobot, HeuristicKind, MassModel, PoseCertificate, SearchKind, Start,
 };
 use roughwalk_core::kinematics::math::Vec3;
+use roughwalk_core::kinematics::quadruped::BodyPose;
 use roughwalk_core::sdf::{DistanceGrid, GridSpec, HeightFieldDistance, SignedDistanceField};
 use roughwalk_core::search::{SolutionReport, Termination};
 use roughwalk_core::CoreError;
@@ -78,6 +79,7 @@ fn parse_config(d: &Bound<'_, PyDict>) -> PyResult<FootstepConfig> {
         max_turn: item(&c, "max_turn")?,
         max_drift: item(&c, "max_drift")?,
         clearance: item(&c, "clearance")?,
+        start_clearance: item(&c, "start_clearance")?,
         clearance_overshoot: item(&c, "clearance_overshoot")?,
         preferred_clearance: item(&c, "preferred_clearance")?,
         clearance_penalty: item(&c, "clearance_penalty")?,
@@ -298,12 +300,14 @@ impl PyFootstepPlanner {
     }
 
     /// Plans from `start_pose` (x, y, yaw) [m, m, rad] — the nominal stance
-    /// there — or from `start_feet` (4, 2) [m] with `next_leg` moving first,
+    /// there — or from `start_feet` (4, 2) [m] with `next_leg` moving first
+    /// (and optionally `start_trunk`, the measured trunk position [m] and
+    /// quaternion (w, x, y, z) the start certificate's search starts from),
     /// to the disc around `goal` (x, y) [m]. Stops after `time_limit` [s]
     /// and/or `expansions` states; `callback(report)` is called with every
     /// improved solution and stops the search by returning True. `search` is
     /// "arastar" or "exhaustive" (Dijkstra, small instances only).
-    #[pyo3(signature = (goal, start_pose=None, start_feet=None, next_leg=2, time_limit=None, expansions=None, callback=None, search="arastar"))]
+    #[pyo3(signature = (goal, start_pose=None, start_feet=None, next_leg=2, time_limit=None, expansions=None, callback=None, search="arastar", start_trunk=None))]
     fn plan<'py>(
         &mut self,
         py: Python<'py>,
@@ -315,19 +319,27 @@ impl PyFootstepPlanner {
         expansions: Option<u64>,
         callback: Option<Py<PyAny>>,
         search: &str,
+        start_trunk: Option<([f64; 3], [f64; 4])>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let start = match (start_pose, start_feet) {
-            (Some((x, y, yaw)), None) => Start::Pose { x, y, yaw },
+            (Some((x, y, yaw)), None) if start_trunk.is_none() => Start::Pose { x, y, yaw },
             (None, Some(f)) => {
                 let v = read(&f, "start_feet", &[4, 2])?;
+                let trunk = start_trunk
+                    .map(|(pos, quat)| BodyPose::new(pos, quat))
+                    .transpose()
+                    .py()?;
                 Start::Feet {
                     feet: std::array::from_fn(|i| [v[2 * i], v[2 * i + 1]]),
                     next_leg,
+                    trunk,
                 }
             }
             _ => {
                 return Err(invalid(
-                    "give exactly one of start_pose (x, y, yaw) and start_feet (4, 2)".into(),
+                    "give exactly one of start_pose (x, y, yaw) and start_feet (4, 2), \
+                     and start_trunk only with start_feet"
+                        .into(),
                 ))
             }
         };

@@ -111,6 +111,17 @@ class CertificateConfig:
         :func:`nominal_body_clearance`). The SDF's
         interpolation error bound is added on top of it, so the true
         clearance is at least this.
+    start_clearance:
+        Least body clearance [m] of a re-plan's start certificate when the
+        re-plan gives the measured trunk pose and no certificate keeps
+        ``clearance``: searched from the measured trunk, as the distance
+        field reads it (its error bound not added, the robot already stands
+        there). Only the start stance: every stance the plan reaches keeps
+        ``clearance``. 0 (no body point inside the terrain) lets the robot
+        walk on from a shin settled against a rock (board Y, sloped rocks
+        seed 1: the RF shin 3.6 mm from the rock face, a certificate needs
+        8.4 mm); larger than ``clearance`` plus the field's error, the
+        measured trunk only seeds the full search.
     clearance_overshoot:
         How far past ``clearance`` the obstacle correction aims [m].
     preferred_clearance:
@@ -149,6 +160,7 @@ class CertificateConfig:
     max_turn: float = 0.15
     max_drift: float = 0.1
     clearance: float = 0.004
+    start_clearance: float = 0.0
     clearance_overshoot: float = 0.002
     preferred_clearance: float = 0.01
     clearance_penalty: float = 0.5

@@ -210,6 +210,7 @@ class FootstepPlanner:
         time_limit: float | None = 2.0,
         expansions: int | None = None,
         callback: SolutionCallback | None = None,
+        trunk: tuple[ArrayLike, ArrayLike] | None = None,
     ) -> FootstepPlan:
         """Plan again from the feet where they stand (after an execution error).
 
@@ -217,7 +218,12 @@ class FootstepPlanner:
         ignored); ``next_leg`` moves first; ``goal`` defaults to the last
         plan's. Its own budget: ``time_limit`` [s] (the paper's recovery
         target is 2 s) and/or ``expansions``. Certificates computed by
-        earlier plans on this terrain are reused.
+        earlier plans on this terrain are reused. ``trunk``, the measured
+        trunk position (3,) [m] and quaternion (4,) (w, x, y, z): where the
+        pose guessed from the feet gives the start stance no certificate, one
+        is searched from there, keeping the body only
+        ``certificate.start_clearance`` off the terrain (the robot stands
+        there already); the stances the plan reaches are certified as ever.
         """
         if goal is None:
             if self._goal is None:
@@ -237,6 +243,11 @@ class FootstepPlanner:
             ) from None
         if f.ndim != 2 or f.shape[0] != 4 or f.shape[1] not in (2, 3):
             raise InvalidArgumentError(f"feet must have shape (4, 2) or (4, 3), got {f.shape}")
+        start_trunk = None
+        if trunk is not None:
+            pos = self._vector(trunk[0], 3, "trunk position")
+            quat = self._vector(trunk[1], 4, "trunk quaternion")
+            start_trunk = (tuple(float(v) for v in pos), tuple(float(v) for v in quat))
         self._goal = (float(g[0]), float(g[1]))
         raw = self._run(
             g,
@@ -246,6 +257,7 @@ class FootstepPlanner:
             "arastar",
             start_feet=np.ascontiguousarray(f[:, :2]),
             next_leg=LEG_INDEX[next_leg],
+            start_trunk=start_trunk,
         )
         return self._result(raw, tuple(float(v) for v in f[:, :2].ravel()), self._goal)
 

@@ -438,6 +438,16 @@ class ReflexConfig:
         difference. 0: no such search, and the run ends there. 0.02 by
         default since session 12 (0 before), with the measured timing (see
         ``foot_force_per_leg``).
+    replan_from_trunk:
+        A re-plan gives the planner the measured trunk pose with the feet:
+        where the pose guessed from the feet gives the stance no
+        certificate, the start's is searched from the trunk, its body kept
+        only ``footstep.certificate.start_clearance`` off the terrain (the
+        robot already stands there; every planned stance keeps the full
+        clearance). If the leg due to lift cannot start the plan, the others
+        are tried in walking order (a leg whose shin settled against a rock
+        must step first: no stance keeping it there has a certificate).
+        Only then the planned footholds and ``replan_nudge_m``.
     max_reflexes:
         Give up (a failed run) after this many reflexes.
     """
@@ -459,6 +469,7 @@ class ReflexConfig:
     replan_budget_s: float = 2.0
     standing_bear: bool = True
     replan_nudge_m: float = 0.02
+    replan_from_trunk: bool = True
     max_reflexes: int = 6
 
     def __post_init__(self) -> None:

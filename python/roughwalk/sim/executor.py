@@ -33,7 +33,7 @@ from roughwalk.errors import PlanningError
 from roughwalk.robots.canonical_frame import LEG_NAMES
 from roughwalk.sim.config import SimConfig
 from roughwalk.sim.cop_stabilizer import CopStabilizer
-from roughwalk.sim.footstep_source import FootstepSource, PlanAttempt, PlanStart
+from roughwalk.sim.footstep_source import CRAWL_ORDER, FootstepSource, PlanAttempt, PlanStart
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
 from roughwalk.sim.outcome import Outcome, OutcomeMonitor
@@ -97,6 +97,13 @@ def nudged_stances(
                 moved = np.array(feet, dtype=float, copy=True)
                 moved[leg, :2] += r * np.array([np.cos(a), np.sin(a)])
                 yield moved
+
+
+def later_legs(leg: int) -> list[int]:
+    """The other legs (canonical indices) in walking order after ``leg``."""
+    order = [LEG_NAMES.index(name) for name in CRAWL_ORDER]
+    k = order.index(leg)
+    return order[k + 1 :] + order[:k]
 
 
 class _Plan:
@@ -552,16 +559,37 @@ class Executor:
 
         Returns whether a plan came, and the simulated time [s] charged.
         """
-        budget = self.config.reflex.replan_budget_s
+        reflex = self.config.reflex
+        budget = reflex.replan_budget_s
+        trunk = (measured.base_pos.copy(), measured.base_quat.copy())
         start = PlanStart(
-            feet=measured.feet.copy(), next_leg=getattr(self, "_reflex_next_leg", None)
+            feet=measured.feet.copy(),
+            next_leg=getattr(self, "_reflex_next_leg", None),
+            trunk=trunk if reflex.replan_from_trunk else None,
         )
         plan, attempt, wall = self._make_plan(start, goal, budget)
         start_from = "measured"
+        if plan is None and reflex.replan_from_trunk and start.next_leg is not None:
+            # The leg due to lift may be the one no stance can keep where it
+            # stands (a shin against a rock): let another step first.
+            for leg in later_legs(start.next_leg):
+                tried_start = PlanStart(feet=start.feet, next_leg=leg, trunk=start.trunk)
+                tried_plan, tried, wall2 = self._make_plan(tried_start, goal, budget)
+                wall += wall2
+                if tried_plan is not None:
+                    plan, attempt, start = tried_plan, tried, tried_start
+                    start_from = f"measured, {LEG_NAMES[leg]} first"
+                    break
+        # No start where the feet stand: no certificate, or (from the measured
+        # trunk, whose certificate may keep only the start clearance) no step
+        # out of it. Then the planned footholds, then the nudged stances.
+        refused = plan is None and (
+            "pose certificate" in attempt.reason
+            or (start.trunk is not None and attempt.status == "infeasible")
+        )
         planned = getattr(self, "_reflex_planned_feet", None)
         if (
-            plan is None
-            and "pose certificate" in attempt.reason
+            refused
             and planned is not None
             and float(np.max(np.linalg.norm((measured.feet - planned)[:, :2], axis=1)))
             <= _NEAR_PLAN_M
@@ -574,7 +602,7 @@ class Executor:
             wall += wall2
             start_from = "planned"
         nudge = self.config.reflex.replan_nudge_m
-        if plan is None and "pose certificate" in attempt.reason and nudge > 0:
+        if plan is None and (refused or "pose certificate" in attempt.reason) and nudge > 0:
             # No certificate where the feet stand nor where they were headed
             # (board Y, sloped rocks seed 1: a foot out of reach): plan from
             # the nearest stance with one foot moved that has one. (That run's

@@ -57,16 +57,21 @@ class PlanStart:
     """A plan's start: a trunk pose, or the feet where they stand.
 
     ``pose`` is (x [m], y [m], yaw [rad]); ``feet`` (4, 3) [m], canonical legs,
-    with ``next_leg`` (canonical index) the leg to move first.
+    with ``next_leg`` (canonical index) the leg to move first and optionally
+    ``trunk``, the measured trunk position (3,) [m] and quaternion (4,)
+    (w, x, y, z) that the start certificate may be searched from.
     """
 
     pose: tuple[float, float, float] | None = None
     feet: NDArray[np.float64] | None = None
     next_leg: int | None = None
+    trunk: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
 
     def __post_init__(self) -> None:
         if (self.pose is None) == (self.feet is None):
             raise InvalidArgumentError("a plan start needs exactly one of pose= or feet=")
+        if self.trunk is not None and self.feet is None:
+            raise InvalidArgumentError("a plan start's trunk= goes with feet=, not pose=")
 
 
 @dataclass(frozen=True)
@@ -256,7 +261,12 @@ class PlannerSource:
             leg = LEG_NAMES[start.next_leg] if start.next_leg is not None else "LH"
             feet, _ = snap_to_footholds(self.planner, self.terrain, start.feet, SNAP_RADIUS_M)
             result = self.planner.replan(
-                feet, leg, goal=g, time_limit=time_limit, expansions=self.expansions
+                feet,
+                leg,
+                goal=g,
+                time_limit=time_limit,
+                expansions=self.expansions,
+                trunk=start.trunk,
             )
         wall = time.perf_counter() - began
         if not result.solved:

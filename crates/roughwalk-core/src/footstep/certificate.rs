@@ -349,13 +349,33 @@ impl CertificateSearch<'_> {
 
     /// Searches for a certificate of the stance whose foot centres are
     /// `feet` [m] and contact points `contacts` [m] (canonical order), with
-    /// the centre of mass over the triangle of the legs `support`.
+    /// the centre of mass over the triangle of the legs `support`, starting
+    /// from the pose [`Self::initial_pose`] guesses from the feet.
     pub fn find(
         &self,
         feet: &[Vec3; 4],
         contacts: &[Vec3; 4],
         support: &[usize; 3],
         heading: f64,
+    ) -> Result<PoseCertificate, CertificateFailure> {
+        let guess = self.initial_pose(feet, contacts, support, heading);
+        let required = self.config.clearance + self.sdf_error;
+        self.find_from(feet, contacts, support, guess, required)
+    }
+
+    /// [`Self::find`] starting from the trunk pose `pose` instead of the
+    /// guess, with the body kept `required` [m] off the terrain as the
+    /// distance field reads it (`find` asks `clearance` plus the field's
+    /// error bound). For a stance the robot already stands on: its measured
+    /// trunk pose, from which the corrections are fewest and the certificate
+    /// nearest where the robot is. `max_drift` is measured from `pose`.
+    pub fn find_from(
+        &self,
+        feet: &[Vec3; 4],
+        contacts: &[Vec3; 4],
+        support: &[usize; 3],
+        pose: BodyPose,
+        required: f64,
     ) -> Result<PoseCertificate, CertificateFailure> {
         let cfg = self.config;
         let legs = self.robot.legs();
@@ -370,10 +390,9 @@ impl CertificateSearch<'_> {
             }
         }
         let tri = support.map(|leg| [contacts[leg][0], contacts[leg][1]]);
-        let required = cfg.clearance + self.sdf_error;
         let cutoff = required.max(cfg.preferred_clearance + self.sdf_error);
         let tolerance = CLEARANCE_TOLERANCE * self.sdf.grid().spec().resolution;
-        let mut pose = self.initial_pose(feet, contacts, support, heading);
+        let mut pose = pose;
         let start = pose.x;
         let mut failure = CertificateFailure::Unreachable;
         let (mut best, mut stalled) = (f64::INFINITY, 0usize);
@@ -670,6 +689,38 @@ mod tests {
             search.find(&far, &far_contacts, &[1, 2, 3], 0.3),
             Err(CertificateFailure::Unreachable)
         );
+    }
+
+    #[test]
+    fn footstep_certificate_from_a_given_pose_keeps_the_clearance_asked() {
+        // The 13 cm mound under the trunk: the guessed pose's knees and trunk
+        // touch it; searched from a pose 3 cm higher, the body is clear at once.
+        let height = |x: f64, y: f64| {
+            let r2 = (x - 0.3).powi(2) + y.powi(2);
+            (0.2 - 30.0 * r2).clamp(0.0, 0.13)
+        };
+        let (_, sdf) = sdf_of(height);
+        let fixture = CertificateFixture::default();
+        let search = fixture.search(&sdf, 0.0);
+        let (feet, contacts) = stance(&height, [0.3, 0.0], 0.0);
+        let support = [1, 2, 3];
+        let guess = search.initial_pose(&feet, &contacts, &support, 0.0);
+        let required = fixture.config.clearance;
+        let lifted = BodyPose {
+            x: add(guess.x, [0.0, 0.0, 0.03]),
+            r: guess.r,
+        };
+        let cert = search
+            .find_from(&feet, &contacts, &support, lifted, required)
+            .expect("clear from the lifted pose");
+        assert_eq!(cert.iterations, 1);
+        assert!(norm(sub(cert.base_pos, lifted.x)) < 1e-12);
+        assert!(cert.clearance >= required);
+        // No pose of these feet holds the body 10 cm off the mound: lifted
+        // that far, the feet are out of reach.
+        assert!(search
+            .find_from(&feet, &contacts, &support, lifted, 0.1)
+            .is_err());
     }
 
     #[test]

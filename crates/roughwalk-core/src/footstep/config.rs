@@ -71,6 +71,11 @@ pub struct CertificateConfig {
     pub max_drift: f64,
     /// Least distance between the robot (feet excluded) and the terrain [m].
     pub clearance: f64,
+    /// Least body clearance [m] of a re-plan's start certificate searched
+    /// from the measured trunk, as the distance field reads it (its error
+    /// bound not added: the robot already stands there). Only the start:
+    /// every planned stance needs `clearance`.
+    pub start_clearance: f64,
     /// How far past `clearance` the obstacle correction aims [m].
     pub clearance_overshoot: f64,
     /// Clearance below which the pose cost rises [m] (≥ `clearance`).
@@ -184,6 +189,7 @@ impl CertificateConfig {
             ("certificate.beta_obstacle", self.beta_obstacle),
             ("certificate.com_margin", self.com_margin),
             ("certificate.clearance", self.clearance),
+            ("certificate.start_clearance", self.start_clearance),
             ("certificate.clearance_overshoot", self.clearance_overshoot),
             ("certificate.clearance_penalty", self.clearance_penalty),
             ("certificate.singularity_margin", self.singularity_margin),

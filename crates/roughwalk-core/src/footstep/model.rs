@@ -26,7 +26,7 @@ use crate::footstep::mass_model::MassModel;
 use crate::footstep::state::{Cell, FootstepState, Lattice};
 use crate::kinematics::leg::LinkFrames;
 use crate::kinematics::math::Vec3;
-use crate::kinematics::quadruped::{leg_q, Quadruped};
+use crate::kinematics::quadruped::{leg_q, BodyPose, Quadruped};
 use crate::kinematics::support::support_triangle_incircle;
 use crate::sdf::SignedDistanceField;
 use crate::search::{SearchProblem, Successor};
@@ -333,6 +333,45 @@ impl FootstepModel {
         let heading = self.lattice().heading(s);
         self.certificate_search()
             .find(&centres, &contacts, &support, heading)
+    }
+
+    /// The certificate of a start stance the robot stands on with its trunk
+    /// at `trunk` (measured): [`Self::certify`]'s, else the search started
+    /// from `trunk`, else that search with the body kept only
+    /// `certificate.start_clearance` off the terrain as the distance field
+    /// reads it. The robot already stands there, so a shin that settled
+    /// against a rock (LittleDog board Y: 3.6 mm from the rock face, where a
+    /// certificate needs 8.4 mm) does not keep it from walking on; every
+    /// stance the plan reaches needs the full clearance. Not cached: the
+    /// outcome depends on `trunk`. The error is [`Self::certify`]'s.
+    pub fn certify_start(
+        &self,
+        s: &FootstepState,
+        trunk: BodyPose,
+    ) -> Result<PoseCertificate, CertificateFailure> {
+        let failure = match self.certify(s) {
+            Ok(c) => return Ok(c),
+            Err(f) => f,
+        };
+        let (centres, contacts) = self.feet_of(s);
+        let support = s.stance_legs(&self.config.walking_order);
+        let search = self.certificate_search();
+        let cfg = &self.config.certificate;
+        let full = cfg.clearance + self.sdf_error;
+        let relaxed = cfg.start_clearance.min(full);
+        let asked: &[f64] = if relaxed < full {
+            &[full, relaxed]
+        } else {
+            &[full]
+        };
+        asked
+            .iter()
+            .find_map(|&required| {
+                search
+                    .find_from(&centres, &contacts, &support, trunk, required)
+                    .ok()
+            })
+            .ok_or(failure)
     }
 
     /// The cached certificate outcome of `s`, and whether it was computed now.

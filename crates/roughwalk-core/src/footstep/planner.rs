@@ -17,7 +17,7 @@ use crate::footstep::model::{
 use crate::footstep::state::FootstepState;
 use crate::heightfield::HeightField;
 use crate::kinematics::math::Vec3;
-use crate::kinematics::quadruped::LEG_NAMES;
+use crate::kinematics::quadruped::{BodyPose, LEG_NAMES};
 use crate::sdf::SignedDistanceField;
 use crate::search::{
     dijkstra, AraStar, AraStarConfig, SearchResult, SearchStats, SearchStatus, SolutionReport,
@@ -44,6 +44,12 @@ pub enum Start {
         feet: [[f64; 2]; 4],
         /// Canonical index (0 LF, 1 RF, 2 LH, 3 RH) of the leg to move first.
         next_leg: usize,
+        /// The trunk pose the robot stands in, measured: where the start
+        /// stance has no certificate from the pose guessed from the feet,
+        /// one is searched from there ([`FootstepModel::certify_start`]).
+        /// Only the start's certificate changes: every planned stance is
+        /// certified as before.
+        trunk: Option<BodyPose>,
     },
 }
 
@@ -134,11 +140,11 @@ impl FootstepPlanner {
         &self.model
     }
 
-    /// The start state of `start`, or why it is invalid.
-    pub fn start_state(&self, start: &Start) -> Result<FootstepState, String> {
+    /// The start state of `start` and its certificate, or why it is invalid.
+    pub fn start_state(&self, start: &Start) -> Result<(FootstepState, PoseCertificate), String> {
         let config = self.model.config();
         let lattice = self.model.lattice();
-        let (feet, next) = match *start {
+        let (feet, next, trunk) = match *start {
             Start::Pose { x, y, yaw } => {
                 if !(x.is_finite() && y.is_finite() && yaw.is_finite()) {
                     return Err(format!("start ({x}, {y}, {yaw}) must be finite"));
@@ -148,9 +154,13 @@ impl FootstepPlanner {
                     .model
                     .nominal_feet()
                     .map(|f| [x + c * f[0] - s * f[1], y + s * f[0] + c * f[1]]);
-                (feet, 0)
+                (feet, 0, None)
             }
-            Start::Feet { feet, next_leg } => {
+            Start::Feet {
+                feet,
+                next_leg,
+                trunk,
+            } => {
                 if !feet.iter().flatten().all(|v| v.is_finite()) {
                     return Err(format!("start feet {feet:?} must be finite"));
                 }
@@ -159,7 +169,16 @@ impl FootstepPlanner {
                         "next_leg {next_leg} is not a leg index; valid: 0..4 (LF, RF, LH, RH)"
                     ));
                 };
-                (feet, next)
+                if let Some(t) = trunk {
+                    let finite =
+                        t.x.iter()
+                            .chain(t.r.iter().flatten())
+                            .all(|v| v.is_finite());
+                    if !finite {
+                        return Err(format!("start trunk pose {t:?} must be finite"));
+                    }
+                }
+                (feet, next, trunk)
             }
         };
         let mut cells = [[0i16; 2]; 4];
@@ -178,13 +197,17 @@ impl FootstepPlanner {
         self.model
             .stance_ok(&state)
             .map_err(|m| format!("start: {m}"))?;
-        if let Err(f) = self.model.certify(&state) {
-            return Err(format!(
+        let certificate = match trunk {
+            Some(pose) => self.model.certify_start(&state, pose),
+            None => self.model.certify(&state),
+        };
+        match certificate {
+            Ok(c) => Ok((state, c)),
+            Err(f) => Err(format!(
                 "start stance has no pose certificate (feet in collision or out of reach): {}",
                 f.describe()
-            ));
+            )),
         }
-        Ok(state)
     }
 
     fn check_goal(&self, goal: [f64; 2]) -> Result<(), String> {
@@ -221,7 +244,7 @@ impl FootstepPlanner {
         self.model.take_counters();
         self.model.take_tree();
         let checked = self.check_goal(goal).and_then(|()| self.start_state(start));
-        let start_state = match checked {
+        let (start_state, start_certificate) = match checked {
             Ok(s) => s,
             Err(message) => return self.invalid(message, started),
         };
@@ -251,7 +274,7 @@ impl FootstepPlanner {
                 r
             }
         };
-        self.finish(result, started)
+        self.finish(result, start_certificate, started)
     }
 
     fn invalid(&mut self, message: String, started: Instant) -> FootstepPlanResult {
@@ -281,6 +304,7 @@ impl FootstepPlanner {
     fn finish(
         &mut self,
         result: SearchResult<FootstepState, FootstepAction>,
+        start: PoseCertificate,
         started: Instant,
     ) -> FootstepPlanResult {
         let mut footsteps = Vec::new();
@@ -297,8 +321,10 @@ impl FootstepPlanner {
                 });
             }
             // Certificates are a function of the stance alone, so these are
-            // the ones the search found (without keeping 18 numbers per edge).
-            start_certificate = self.model.certify(&plan.states[0]).ok();
+            // the ones the search found (without keeping 18 numbers per edge);
+            // the start's is the one `start_state` found (maybe from the
+            // measured trunk).
+            start_certificate = Some(start);
             for (action, state) in plan.actions.iter().zip(&plan.states[1..]) {
                 footsteps.push(Footstep {
                     leg: usize::from(action.leg),
@@ -529,6 +555,7 @@ pub(crate) mod tests {
                 Start::Feet {
                     feet: [[0.65, 0.06], [0.29, -0.06], [0.11, 0.06], [0.11, -0.06]],
                     next_leg: 2,
+                    trunk: None,
                 },
                 [0.6, 0.0],
                 "out of reach",
@@ -537,6 +564,7 @@ pub(crate) mod tests {
                 Start::Feet {
                     feet: [[0.3, 0.06], [0.3, -0.06], [0.11, 0.06], [0.11, -0.06]],
                     next_leg: 7,
+                    trunk: None,
                 },
                 [0.6, 0.0],
                 "next_leg",

@@ -1,0 +1,81 @@
+"""Where a re-plan starts: the measured feet and trunk, and which leg steps first (issue 7)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+from numpy.typing import NDArray
+
+import roughwalk
+from roughwalk.config import override
+from roughwalk.sim import CrawlSource
+from roughwalk.sim.config import SimConfig
+from roughwalk.sim.executor import Executor, later_legs
+from roughwalk.sim.footstep_source import PlanAttempt, PlanStart
+from roughwalk.sim.runner import Runner
+from roughwalk.sim.world import World
+
+LF, RF, LH, RH = range(4)
+
+
+class OnlyOneLegSteps:
+    """A crawl source with no plan unless ``leg`` steps first (a shin against a rock)."""
+
+    name = "only-one-leg"
+
+    def __init__(self, robot: roughwalk.Robot, terrain: roughwalk.Terrain, leg: int) -> None:
+        self.crawl = CrawlSource(robot, terrain)
+        self.leg = leg
+        self.starts: list[PlanStart] = []
+
+    def plan(self, start: PlanStart, goal: NDArray[np.float64], time_limit: float) -> PlanAttempt:
+        self.starts.append(start)
+        if start.next_leg != self.leg:
+            return PlanAttempt(None, "infeasible", "the planner found no plan (infeasible)", 0.0)
+        return self.crawl.plan(start, goal, time_limit)
+
+
+@pytest.fixture(scope="module")
+def standing() -> tuple[roughwalk.Robot, roughwalk.Terrain, Any]:
+    robot = roughwalk.load_robot("littledog")
+    terrain = roughwalk.load_terrain("flat")
+    st = robot.nominal_stance
+    base = np.array([0.5, 0.0, st.base_height])
+    quat = np.array([1.0, 0.0, 0.0, 0.0])
+    q, _ = robot.inverse_kinematics(st.feet + base, base, quat)
+    measured = Runner(World(robot, terrain)).reset(q, base, quat)
+    return robot, terrain, measured
+
+
+def replan(standing: Any, from_trunk: bool) -> tuple[bool, OnlyOneLegSteps, dict[str, Any]]:
+    robot, terrain, measured = standing
+    source = OnlyOneLegSteps(robot, terrain, RF)
+    config = override(SimConfig(), {"reflex.replan_from_trunk": from_trunk})
+    executor = Executor(robot, terrain, source, config=config)
+    executor._reflex_next_leg = LF
+    holding = executor._standing(measured)
+    ok, _ = executor._replan(measured, holding, np.array([1.0, 0.0]), measured.time)
+    return ok, source, executor.log.events[-1]
+
+
+def test_the_other_legs_are_tried_in_walking_order_after_the_one_due() -> None:
+    assert later_legs(LF) == [RH, RF, LH]
+    assert later_legs(RF) == [LH, LF, RH]
+
+
+def test_a_replan_gives_the_measured_trunk_and_lets_another_leg_step_first(standing) -> None:
+    _, _, measured = standing
+    ok, source, event = replan(standing, from_trunk=True)
+    assert ok and event["start"] == "measured, RF first"
+    assert [s.next_leg for s in source.starts] == [LF, RH, RF]
+    for start in source.starts:
+        assert start.trunk is not None
+        np.testing.assert_array_equal(start.trunk[0], measured.base_pos)
+        np.testing.assert_array_equal(start.trunk[1], measured.base_quat)
+        np.testing.assert_array_equal(start.feet, measured.feet)
+    # Off: the leg due, without the trunk, and the run ends there.
+    ok, source, event = replan(standing, from_trunk=False)
+    assert not ok and event["start"] == "measured"
+    assert [(s.next_leg, s.trunk) for s in source.starts] == [(LF, None)]
