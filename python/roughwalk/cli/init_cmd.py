@@ -73,7 +73,13 @@ def register(sub: Any) -> None:
     g.add_argument("--split", default="train", choices=("train", "test"), help="task stream")
     g.add_argument("--seed", type=int, default=0, help="task sampling seed")
     g.add_argument("--max-iter", type=int, help="IPOPT iterations (default 100, N_h)")
-    g.add_argument("--init", default="heuristic", help="heuristic (default) or learned:MODEL")
+    g.add_argument(
+        "--init",
+        default="heuristic",
+        help="heuristic (default), learned:MODEL, or nearest:RUN[,RUN...]: each task from the "
+        "solution of the nearest feasible solve of those run folders and this run, nearest "
+        "tasks first",
+    )
     g.add_argument("--out", type=Path, help="run folder (default .experience/ENV_GAITSTEPS_SPLIT)")
     g.add_argument(
         "--jitter",
@@ -154,6 +160,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     """Solve ``--tasks`` sampled tasks into a resumable run folder."""
     from roughwalk.learning.executors import make_executor
     from roughwalk.learning.experience import N_HEURISTIC, generate
+    from roughwalk.learning.neighbour_starts import parse_nearest
     from roughwalk.learning.problem_spec import (
         ProblemSpec,
         constraint_set,
@@ -174,10 +181,11 @@ def cmd_generate(args: argparse.Namespace) -> int:
         solver_settings(args.set),
     )
     out = args.out or DEFAULT_ROOT / f"{space.name}_{args.gait}{args.steps}_{args.split}"
-    jitter = _jitter(args.jitter, args.init != "heuristic")
+    seeds = parse_nearest(args.init)
+    jitter = _jitter(args.jitter, args.init != "heuristic" and seeds is None)
     model = None
     max_iter = args.max_iter
-    if args.init != "heuristic":
+    if args.init != "heuristic" and seeds is None:
         from roughwalk.learning.initializer import model_for_spec
 
         model = model_for_spec(args.init, spec)
@@ -206,6 +214,8 @@ def cmd_generate(args: argparse.Namespace) -> int:
         indices=indices,
         jitter=jitter,
         jitter_seed=args.jitter_seed,
+        seeds=seeds,
+        batch=args.workers,
     )
     solved = int(sum(s in ("exact", "approximate") for s in data["status"]))
     print(f"{len(data)} tasks in {out / 'dataset.npz'}: {solved} converged")
