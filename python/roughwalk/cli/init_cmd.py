@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -92,6 +93,11 @@ def register(sub: Any) -> None:
         "--start-x-max",
         type=float,
         help="solve only the tasks (of the first --tasks) whose start x is at most this (m)",
+    )
+    g.add_argument(
+        "--start-x-min",
+        type=float,
+        help="solve only the tasks (of the first --tasks) whose start x is at least this (m)",
     )
     g.set_defaults(func=cmd_generate)
 
@@ -191,11 +197,13 @@ def cmd_generate(args: argparse.Namespace) -> int:
         model = model_for_spec(args.init, spec)
         max_iter = 25 if max_iter is None else max_iter
     indices = None
-    if args.start_x_max is not None:
+    if args.start_x_max is not None or args.start_x_min is not None:
+        low = -math.inf if args.start_x_min is None else args.start_x_min
+        high = math.inf if args.start_x_max is None else args.start_x_max
         indices = [
             i
             for i in range(args.tasks)
-            if space.task(i, seed=args.seed, split=args.split).start[0] <= args.start_x_max
+            if low <= space.task(i, seed=args.seed, split=args.split).start[0] <= high
         ]
     executor = make_executor(args.executor, workers=args.workers, address=args.address)
     n = args.tasks if indices is None else len(indices)
