@@ -214,7 +214,8 @@ def test_jittered_starts_depend_on_seed_and_index_only() -> None:
 def test_generate_cli_selects_far_starts_and_checks_jitter(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """``--start-x-max`` solves only the far starts; ``--jitter`` needs a model and 3 numbers."""
+    """``--start-x-max`` / ``--start-x-min`` solve only the far / near starts; ``--jitter``
+    needs a model and 3 numbers."""
     from roughwalk.cli.main import main
     from roughwalk.learning.task_space import ENVIRONMENTS
 
@@ -227,6 +228,10 @@ def test_generate_cli_selects_far_starts_and_checks_jitter(
     far = [i for i, x in enumerate(starts) if x <= x_max]
     assert 0 < len(far) < 6
     assert read_run(out)["index"].tolist() == far
+    near = tmp_path / "near"
+    args = [*common, "--tasks", "6", "--max-iter", "0", "--start-x-min", str(x_max)]
+    assert main([*args, "--out", str(near)]) == 0
+    assert read_run(near)["index"].tolist() == [i for i, x in enumerate(starts) if x >= x_max]
     capsys.readouterr()
     for bad, says in (
         (["--jitter", "0.1,0.1,0.1"], "give --init learned:MODEL"),

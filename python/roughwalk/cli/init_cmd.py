@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -73,7 +74,13 @@ def register(sub: Any) -> None:
     g.add_argument("--split", default="train", choices=("train", "test"), help="task stream")
     g.add_argument("--seed", type=int, default=0, help="task sampling seed")
     g.add_argument("--max-iter", type=int, help="IPOPT iterations (default 100, N_h)")
-    g.add_argument("--init", default="heuristic", help="heuristic (default) or learned:MODEL")
+    g.add_argument(
+        "--init",
+        default="heuristic",
+        help="heuristic (default), learned:MODEL, or nearest:RUN[,RUN...]: each task from the "
+        "solution of the nearest feasible solve of those run folders and this run, nearest "
+        "tasks first",
+    )
     g.add_argument("--out", type=Path, help="run folder (default .experience/ENV_GAITSTEPS_SPLIT)")
     g.add_argument(
         "--jitter",
@@ -86,6 +93,11 @@ def register(sub: Any) -> None:
         "--start-x-max",
         type=float,
         help="solve only the tasks (of the first --tasks) whose start x is at most this (m)",
+    )
+    g.add_argument(
+        "--start-x-min",
+        type=float,
+        help="solve only the tasks (of the first --tasks) whose start x is at least this (m)",
     )
     g.set_defaults(func=cmd_generate)
 
@@ -154,6 +166,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     """Solve ``--tasks`` sampled tasks into a resumable run folder."""
     from roughwalk.learning.executors import make_executor
     from roughwalk.learning.experience import N_HEURISTIC, generate
+    from roughwalk.learning.neighbour_starts import parse_nearest
     from roughwalk.learning.problem_spec import (
         ProblemSpec,
         constraint_set,
@@ -174,20 +187,23 @@ def cmd_generate(args: argparse.Namespace) -> int:
         solver_settings(args.set),
     )
     out = args.out or DEFAULT_ROOT / f"{space.name}_{args.gait}{args.steps}_{args.split}"
-    jitter = _jitter(args.jitter, args.init != "heuristic")
+    seeds = parse_nearest(args.init)
+    jitter = _jitter(args.jitter, args.init != "heuristic" and seeds is None)
     model = None
     max_iter = args.max_iter
-    if args.init != "heuristic":
+    if args.init != "heuristic" and seeds is None:
         from roughwalk.learning.initializer import model_for_spec
 
         model = model_for_spec(args.init, spec)
         max_iter = 25 if max_iter is None else max_iter
     indices = None
-    if args.start_x_max is not None:
+    if args.start_x_max is not None or args.start_x_min is not None:
+        low = -math.inf if args.start_x_min is None else args.start_x_min
+        high = math.inf if args.start_x_max is None else args.start_x_max
         indices = [
             i
             for i in range(args.tasks)
-            if space.task(i, seed=args.seed, split=args.split).start[0] <= args.start_x_max
+            if low <= space.task(i, seed=args.seed, split=args.split).start[0] <= high
         ]
     executor = make_executor(args.executor, workers=args.workers, address=args.address)
     n = args.tasks if indices is None else len(indices)
@@ -206,6 +222,8 @@ def cmd_generate(args: argparse.Namespace) -> int:
         indices=indices,
         jitter=jitter,
         jitter_seed=args.jitter_seed,
+        seeds=seeds,
+        batch=args.workers,
     )
     solved = int(sum(s in ("exact", "approximate") for s in data["status"]))
     print(f"{len(data)} tasks in {out / 'dataset.npz'}: {solved} converged")

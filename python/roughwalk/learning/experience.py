@@ -15,7 +15,7 @@ import json
 import os
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
@@ -27,6 +27,7 @@ from roughwalk.errors import ConfigError
 from roughwalk.learning.dataset import COLUMNS, Dataset
 from roughwalk.learning.executors import Executor, LocalExecutor
 from roughwalk.learning.model_costs import cost_changes
+from roughwalk.learning.neighbour_starts import NEAREST_INIT, neighbour_solves, seed_pool
 from roughwalk.learning.problem_spec import (
     UNRECORDED_SOLVE_SETTINGS,
     ProblemSpec,
@@ -376,6 +377,8 @@ def generate(
     indices: Sequence[int] | None = None,
     jitter: Sequence[float] | None = None,
     jitter_seed: int = 0,
+    seeds: Sequence[str | Path] | None = None,
+    batch: int = 1,
 ) -> Dataset:
     """Solve tasks 0..n_tasks−1 of ``space``'s ``split`` into ``folder``; resume what is there.
 
@@ -408,6 +411,12 @@ def generate(
         With a model: ask it for the guess of a task whose start is moved
         by these standard deviations (x [m], y [m], yaw [rad]); see
         :func:`jittered`. Recorded in the run.
+    seeds, batch:
+        Instead of a model: start each task at the solution (and
+        multipliers) of the nearest feasible solve of these run folders and
+        of this run, nearest tasks first, ``batch`` (the executor's workers)
+        at a time (:mod:`~roughwalk.learning.neighbour_starts`); ``init``
+        names them (``nearest:RUN,...``).
 
     Returns
     -------
@@ -420,6 +429,10 @@ def generate(
             f"the problem is on terrain '{spec.terrain}' but the task space "
             f"'{space.name}' is on '{space.terrain}'"
         )
+    if seeds is not None and model is not None:
+        raise ConfigError("a run starts from a model's guesses or from seed runs' solves, not both")
+    if seeds is not None:
+        init = f"{NEAREST_INIT}:{','.join(str(f) for f in seeds)}"
     run = ExperienceRun(
         folder,
         {
@@ -494,7 +507,15 @@ def generate(
         run._write_meta()
     started = time.perf_counter()
     finished = len(wanted) - len(todo)
-    for row in (executor or LocalExecutor(1)).run(solve_job, jobs):
+    executor = executor or LocalExecutor(1)
+    if seeds is None:
+        results: Iterator[dict[str, Any]] = executor.run(solve_job, jobs)
+    else:
+        pool = seed_pool(spec, space, [Path(f) for f in seeds])
+        for row in run.rows():
+            pool.add(row)
+        results = neighbour_solves(spec, todo, tasks, pool, max_iter, executor, batch)
+    for row in results:
         run.record(row)
         finished += 1
         if progress is not None:
