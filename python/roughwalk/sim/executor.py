@@ -295,6 +295,8 @@ class Executor:
                     step=current.step,
                     leg=current.info.get("leg"),
                     valid=current.info.get("valid"),
+                    fitted_s=current.info.get("fitted_s"),
+                    stretch_s=current.info.get("stretch_s"),
                 )
                 self._schedule_next(now)
             if desired is None:
