@@ -413,7 +413,20 @@ class ReflexConfig:
         hold ran its whole ``settle_max_s``: the reflex took 2.32 s of the
         run's 6.78. 3 counts a still trunk on three loaded feet as settled;
         rocking from the left feet to the right ones still loads only two
-        at its ends.
+        at its ends. Session 13 (``roughwalk bench littledog --expansions
+        40000 --seeds 2``; only runs with a reflex can change, and each of
+        those was run again): with the joint swing options
+        (``trajectory.swing.time_law=joint``, ``swing.path=joint``,
+        ``swing.ramp_fraction=0.1``) logs 5.00 → 5.64 cm/s (seed 1 4.35 →
+        5.61), barrier 6.94 → 7.37 (seed 0 6.13 → 6.99), every other run
+        the same (large rocks seed 0 and sloped rocks seed 1 fail with
+        both); with the defaults barrier 5.83 → 6.14 (seed 0 5.17 → 5.79)
+        but large rocks 4.40 → 4.17 (seed 0 3.84 → 3.37: re-planned 0.04 s
+        sooner, from a stance a hair different, it met a second
+        foot-force reflex). 1 N·s side-push sweeps (``roughwalk bench
+        push_recovery --from 1.6 --to 3.2 --direction ±90``): 8/9 and 8/9,
+        the same push times, with 3 and 4. Not the default: with the
+        default gait one class is slower.
     lower_s:
         Time [s] to put all four feet down and centre the trunk over them.
     capture_max_m:
