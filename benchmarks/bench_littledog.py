@@ -31,6 +31,14 @@ of ``--classes steps --expansions 40000 --seeds 2`` with the fast timing:
 every field of every run the same but the wall time). 40000 is about what
 the initial plan expands in the default 5 s: 22000–63000 states on barrier,
 steps and round rocks, seeds 0–1, on this 2-core machine under load.
+After the table's ``|``, each class's clock (first motion to the goal or
+the end, summed over its runs) splits into shares, in per cent: shifts,
+swings, stretch (a shift's or swing's time beyond its fitted timing: the
+re-timing for joint speed limits and the restarts), the last footstep's
+settling, waits for optimisation, reflexes' recoveries and re-plans (the
+charged planning time and the blend back into the walk); each run's own
+split is its ``extra.time_breakdown``, each class's seconds its summary's
+``time_s``.
 Writes ``benchmarks/results/littledog.json``.
 """
 
@@ -60,6 +68,17 @@ SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "terrains" / "l
 BOARDS = {"large_rocks": "AE", "round_rocks": "AC", "sloped_rocks": "Y", "logs": "AD"}
 CLASSES = ("large_rocks", "round_rocks", "sloped_rocks", "logs", "gap", "barrier", "steps")
 TARGET_CM_S = 7.2
+# Shares of a run's clock (roughwalk.sim.time_breakdown) and their columns' heads.
+SHARES = ("shift", "swing", "stretch", "settle", "wait", "reflex", "replan")
+SHARE_HEADS = {
+    "shift": "shift%",
+    "swing": "swing%",
+    "stretch": "strch%",
+    "settle": "settl%",
+    "wait": "wait%",
+    "reflex": "reflx%",
+    "replan": "replan%",
+}
 # A reflex this soon [s] after the first motion counts as the start not holding.
 PLACEMENT_S = 0.1
 # Time limit [s] of every plan under --expansions: a cap the budget should reach first.
@@ -222,8 +241,22 @@ def seeded_run(args: Job) -> dict[str, Any]:
     return r
 
 
+def time_shares(runs: list[dict[str, Any]]) -> dict[str, float]:
+    """Seconds of each share of the clock (:data:`SHARES`), summed over the runs.
+
+    From each run's ``extra.time_breakdown`` (:mod:`roughwalk.sim.time_breakdown`):
+    the time from the first motion to the goal or the end, successful runs or not.
+    """
+    total = dict.fromkeys(SHARES, 0.0)
+    for r in runs:
+        split = (r.get("extra") or {}).get("time_breakdown") or {}
+        for k in SHARES:
+            total[k] += float(split.get(f"{k}_s") or 0.0)
+    return total
+
+
 def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
-    """Success rate, speeds of the successful runs, counts."""
+    """Success rate, speeds of the successful runs, counts, where the clock went."""
     ok = [r for r in runs if r["success"]]
     speeds = [r["speed_cm_s"] for r in ok]
     return {
@@ -236,6 +269,7 @@ def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
         "rescued": int(sum(r["rescued"] for r in runs)),
         "wait_s": float(sum(r["wait_s"] for r in runs)),
         "failures": sorted({r["reason"] for r in runs if not r["success"]}),
+        "time_s": time_shares(runs),
     }
 
 
@@ -246,9 +280,17 @@ def print_row(name: str, s: dict[str, Any]) -> None:
     met = "yes" if ok and s["speed_cm_s_mean"] >= TARGET_CM_S else "no"
     print(
         f"{name:<28} {s['runs']:>4} {100 * s['success_rate']:>7.0f}% {speed:>9} "
-        f"{s['reflexes']:>8} {s['replans']:>7} {s['rescued']:>7} {s['wait_s']:>7.1f} {met:>6}",
+        f"{s['reflexes']:>8} {s['replans']:>7} {s['rescued']:>7} {s['wait_s']:>7.1f} {met:>6}"
+        f" |{share_columns(s['time_s'])}",
         flush=True,
     )
+
+
+def share_columns(seconds: dict[str, float]) -> str:
+    """The clock's shares as percentages of their sum, one column each (see :data:`SHARES`)."""
+    total = sum(seconds.values())
+    cells = [f"{100 * seconds[k] / total:.0f}" if total > 0 else "—" for k in SHARES]
+    return "".join(f" {c:>{len(SHARE_HEADS[k])}}" for k, c in zip(SHARES, cells, strict=True))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -313,8 +355,10 @@ def main(argv: list[str] | None = None) -> int:
     header = (
         f"{'terrain class':<28} {'runs':>4} {'success':>8} {'cm/s':>9} {'reflexes':>8} "
         f"{'replans':>7} {'rescued':>7} {'wait s':>7} {'target':>6}"
+        f" |{''.join(' ' + SHARE_HEADS[k] for k in SHARES)}"
     )
     print(f"LittleDog in MuJoCo, {seeds} runs per class; target ≥95% at ≥{TARGET_CM_S} cm/s")
+    print("after |: % of the runs' clock (first motion to goal or end) per share")
     print(header)
     print("-" * len(header))
     table: dict[str, Any] = {}

@@ -8,8 +8,15 @@ import numpy as np
 import pytest
 
 import roughwalk
+from roughwalk.sim.config import ReflexConfig
 from roughwalk.sim.executor import nudged_stances
-from roughwalk.sim.recovery import centred_fit, off_edge, recovery_segment, standing_feet
+from roughwalk.sim.recovery import (
+    centred_fit,
+    off_edge,
+    recovery_segment,
+    settled,
+    standing_feet,
+)
 from roughwalk.sim.runner import Runner
 from roughwalk.sim.world import World
 from roughwalk.trajectories.body_keyframes import nominal_fit
@@ -172,3 +179,33 @@ def test_a_replan_without_a_start_certificate_tries_stances_one_foot_moved_neare
     legs = moved.argmax(axis=1)
     np.testing.assert_array_equal(legs[:32], np.repeat([2, 0, 1, 3], 8))
     assert list(nudged_stances(feet, 0.0)) == []
+
+
+def test_a_still_robot_on_three_loaded_feet_is_settled_only_when_three_are_asked_for(
+    standing,
+) -> None:
+    """The recovery's hold ends on a still trunk and ``reflex.settled_loaded_feet`` loaded feet.
+
+    Four feet share the load indeterminately: on the logs board one rested
+    unloaded after a recovery and the hold ran its whole extension.
+    """
+    _, _, measured = standing
+
+    def state(fz: list[float], rate: float) -> object:
+        forces = np.zeros((4, 3))
+        forces[:, 2] = fz
+        return dataclasses.replace(
+            measured, foot_forces=forces, base_angvel=np.array([rate, 0.0, 0.0])
+        )
+
+    still = state([9.0, 0.0, 8.0, 9.5], 0.05)  # RF a millimetre high: no load
+    assert not settled(still, 0.2, 4, 1.0)
+    assert settled(still, 0.2, 3, 1.0)
+    # Rocking onto the left feet: two loaded, not settled either way.
+    assert not settled(state([13.0, 0.0, 13.5, 0.0], 0.05), 0.2, 3, 1.0)
+    # Turning faster than the rate: not settled, however many feet bear load.
+    assert not settled(state([6.7] * 4, 0.3), 0.2, 3, 1.0)
+    assert settled(state([6.7] * 4, 0.05), 0.2, 4, 1.0)
+    assert ReflexConfig().settled_loaded_feet == 4
+    with pytest.raises(roughwalk.ConfigError, match="settled_loaded_feet must be 3 or 4"):
+        ReflexConfig(settled_loaded_feet=2)

@@ -109,6 +109,25 @@ def test_a_hurried_swing_is_lengthened_before_chomp(crawl, littledog: rw.Robot) 
     assert 1.0 < stretch <= ratio * RETIME_MARGIN * 1.1 + 0.05
 
 
+def test_the_report_names_the_stretch_beyond_the_fitted_timing(littledog: rw.Robot) -> None:
+    """Hurried swings kept as fitted (no measured timing): the report says how much they grew.
+
+    What a run's time breakdown counts as stretch (:mod:`roughwalk.sim.time_breakdown`).
+    """
+    terrain = rw.load_terrain("flat:length=1.2,width=0.5")
+    config = rw.trajectories.trajectory_config(**{"timing.measured_speed": 0.0})
+    gen = FootstepTrajectoryGenerator(littledog, terrain, config=config)
+    plan = straight_crawl_plan(littledog, terrain, (0.3, 0.0), steps=4, stride=0.07)
+    hurried = _hurried(gen.prepare(plan), 0.4)
+    first = next(iter(gen.iter_steps(hurried)))
+    r = first.report
+    assert r.fitted_swing_s == pytest.approx(hurried.timings[0].swing_s)
+    assert r.fitted_shift_s == pytest.approx(hurried.timings[0].shift_s)
+    assert r.swing_s > 1.5 * r.fitted_swing_s
+    assert r.stretch_s[1] == pytest.approx(r.swing_s - r.fitted_swing_s)
+    assert r.stretch_s[0] == pytest.approx(max(r.shift_s - r.fitted_shift_s, 0.0))
+
+
 def test_steps_within_the_limits_are_not_stretched(littledog: rw.Robot) -> None:
     """The barrier step at its nominal timing already keeps the limits: its duration stays."""
     terrain = rw.load_terrain(BARRIER)
@@ -118,6 +137,8 @@ def test_steps_within_the_limits_are_not_stretched(littledog: rw.Robot) -> None:
     assert swing_speed_ratio(state, gen.wb, gen.config.control_rate_hz) <= 1.0
     traj = next(iter(gen.iter_steps(prepared)))
     assert traj.report.duration_s == pytest.approx(prepared.timings[0].duration_s)
+    assert traj.report.stretch_s == (0.0, 0.0)
+    assert traj.report.fitted_swing_s == pytest.approx(traj.report.swing_s)
 
 
 def test_a_velocity_jump_is_not_restarted(crawl, littledog: rw.Robot) -> None:

@@ -403,6 +403,30 @@ class ReflexConfig:
         ``measured_speed`` 0.9).
     settle_max_s:
         Longest extension [s] of the hold for that; then the re-plan starts anyway.
+    settled_loaded_feet:
+        How many feet (3 or 4) must bear load for the robot to count as
+        settled (with the trunk turning slower than ``settled_rate_rad_s``).
+        Four feet down share the load indeterminately: one a millimetre
+        high carries nothing, however still the robot stands. On the
+        LittleDog logs board (AD, bench seed 1, ``--expansions 40000``, the
+        joint swing options) RF rested unloaded after the recovery and the
+        hold ran its whole ``settle_max_s``: the reflex took 2.32 s of the
+        run's 6.78. 3 counts a still trunk on three loaded feet as settled;
+        rocking from the left feet to the right ones still loads only two
+        at its ends. Session 13 (``roughwalk bench littledog --expansions
+        40000 --seeds 2``; only runs with a reflex can change, and each of
+        those was run again): with the joint swing options
+        (``trajectory.swing.time_law=joint``, ``swing.path=joint``,
+        ``swing.ramp_fraction=0.1``) logs 5.00 → 5.64 cm/s (seed 1 4.35 →
+        5.61), barrier 6.94 → 7.37 (seed 0 6.13 → 6.99), every other run
+        the same (large rocks seed 0 and sloped rocks seed 1 fail with
+        both); with the defaults barrier 5.83 → 6.14 (seed 0 5.17 → 5.79)
+        but large rocks 4.40 → 4.17 (seed 0 3.84 → 3.37: re-planned 0.04 s
+        sooner, from a stance a hair different, it met a second
+        foot-force reflex). 1 N·s side-push sweeps (``roughwalk bench
+        push_recovery --from 1.6 --to 3.2 --direction ±90``): 8/9 and 8/9,
+        the same push times, with 3 and 4. Not the default: with the
+        default gait one class is slower.
     lower_s:
         Time [s] to put all four feet down and centre the trunk over them.
     capture_max_m:
@@ -464,6 +488,7 @@ class ReflexConfig:
     settle_s: float = 0.3
     settled_rate_rad_s: float = 0.2
     settle_max_s: float = 1.5
+    settled_loaded_feet: int = 4
     lower_s: float = 0.5
     capture_max_m: float = 0.04
     replan_budget_s: float = 2.0
@@ -499,6 +524,10 @@ class ReflexConfig:
             ),
             "reflex",
         )
+        if self.settled_loaded_feet not in (3, 4) or isinstance(self.settled_loaded_feet, bool):
+            raise ConfigError(
+                f"reflex.settled_loaded_feet must be 3 or 4, got {self.settled_loaded_feet!r}"
+            )
         if not (isinstance(self.max_reflexes, int) and self.max_reflexes >= 0):
             raise ConfigError(
                 f"reflex.max_reflexes must be an integer ≥ 0, got {self.max_reflexes}"

@@ -42,6 +42,7 @@ from roughwalk.sim.recovery import (
     hold_segment,
     pose_segment,
     recovery_segment,
+    settled,
     standing_feet,
 )
 from roughwalk.sim.reflexes import ReflexMonitor
@@ -302,6 +303,8 @@ class Executor:
                     step=current.step,
                     leg=current.info.get("leg"),
                     valid=current.info.get("valid"),
+                    fitted_s=current.info.get("fitted_s"),
+                    stretch_s=current.info.get("stretch_s"),
                 )
                 self._schedule_next(now)
             if desired is None:
@@ -505,16 +508,15 @@ class Executor:
         it; a re-plan whose first step lifts a foot then tips the robot
         over and fires the next reflex. So the hold goes on, up to
         ``reflex.settle_max_s`` more, until the trunk turns slower than
-        ``reflex.settled_rate_rad_s`` with every foot bearing load.
+        ``reflex.settled_rate_rad_s`` with ``reflex.settled_loaded_feet``
+        feet bearing load.
         """
         cfg = self.config.reflex
         if self._settle_deadline is None:
             self._settle_deadline = now + cfg.settle_max_s
         if now >= self._settle_deadline - 1e-9:
             return True
-        turning = float(np.linalg.norm(measured.base_angvel))
-        loaded = bool(np.all(measured.foot_forces[:, 2] > _LOADED_N))
-        return turning < cfg.settled_rate_rad_s and loaded
+        return settled(measured, cfg.settled_rate_rad_s, cfg.settled_loaded_feet, _LOADED_N)
 
     def _catch(
         self, q_cmd: np.ndarray, desired: DesiredState, measured: MeasuredState

@@ -46,6 +46,7 @@ __all__ = [
     "min_jerk",
     "off_edge",
     "standing_feet",
+    "settled",
 ]
 
 _RATE_HZ = 100.0
@@ -314,6 +315,20 @@ def standing_feet(
     ground = terrain.height(measured.feet[:, :2])
     low = measured.feet[:, 2] - ground - robot.foot_radius < STANDING_M
     return np.asarray(loaded | (np.asarray(support, dtype=bool) & low), dtype=bool)
+
+
+def settled(measured: MeasuredState, rate_rad_s: float, loaded_feet: int, loaded_n: float) -> bool:
+    """Whether a recovered robot stands still on ``loaded_feet`` loaded feet.
+
+    The trunk turns slower than ``rate_rad_s`` [rad/s] with at least
+    ``loaded_feet`` feet pressing down by over ``loaded_n`` [N]
+    (:attr:`~roughwalk.sim.config.ReflexConfig.settled_loaded_feet`: four
+    feet down share the load indeterminately, so a still robot can stand on
+    three.)
+    """
+    turning = float(np.linalg.norm(measured.base_angvel))
+    loaded = int(np.sum(np.asarray(measured.foot_forces)[:, 2] > loaded_n))
+    return turning < rate_rad_s and loaded >= loaded_feet
 
 
 def recovery_segment(

@@ -114,8 +114,10 @@ def write_report(
     if split and split.get("footsteps"):
         text = (
             f"shifts {split['shift_s']:.1f} s, swings {split['swing_s']:.1f} s, "
+            f"stretched {split.get('stretch_s', 0.0):.1f} s, "
             f"settling {split['settle_s']:.1f} s, waits {split['wait_s']:.1f} s, "
-            f"reflexes {split['reflex_s']:.1f} s; {split['footsteps']} footsteps, "
+            f"reflexes {split['reflex_s']:.1f} s, re-plans {split.get('replan_s', 0.0):.1f} s; "
+            f"{split['footsteps']} footsteps, "
             f"mean stride {100 * split['mean_stride_m']:.1f} cm"
         )
         parts.append(f"<tr><th>where the time went</th><td>{html.escape(text)}</td></tr>")

@@ -1,4 +1,4 @@
-"""Where a run's clock went: per footstep, the shift, swing, settle, waits and reflexes.
+"""Where a run's clock went: per footstep, the shift, swing, stretch, settle, waits and reflexes.
 
 The Learning Locomotion speed (Zucker 2011, §1) is the distance over the time
 from the first motion to the goal. :func:`time_breakdown` splits that time,
@@ -6,12 +6,17 @@ from a :class:`~roughwalk.sim.run_log.RunLog`, by what the executor did at
 each control tick:
 
 * ``shift``: a footstep's four-foot phase (the trunk moves the centre of
-  pressure into the next support triangle);
-* ``swing``: a foot in the air;
+  pressure into the next support triangle), as long as its fitted timing;
+* ``swing``: a foot in the air, as long as its fitted timing;
+* ``stretch``: the part of a shift or swing beyond its fitted timing (what
+  the generator's re-timing for joint speed limits, its restarts (§5.3) and
+  its fall-back to the nominal timing added; from the ``step`` events'
+  ``fitted_s``);
 * ``settle``: the last footstep's final four-foot phase;
 * ``wait``: holding for a footstep whose optimisation has not finished;
-* ``reflex``: a reflex's recovery, the re-plan and the blend into the new
-  plan (the robot stands or puts its feet down);
+* ``reflex``: a reflex's recovery (the feet put down, the robot settling);
+* ``replan``: standing while the re-plan's charged time runs, and the blend
+  into the new plan;
 
 and gives each footstep's stride: how far its swing foot moved (x–y) and how
 far the feet's centroid advanced. Speed is stride over footstep time, so the
@@ -29,7 +34,8 @@ from roughwalk.sim.run_log import MODES, OTHER_PHASE, RunLog
 
 __all__ = ["FootstepTime", "TimeBreakdown", "time_breakdown"]
 
-_SHARES = ("shift", "swing", "settle", "wait", "reflex")
+_SHARES = ("shift", "swing", "stretch", "settle", "wait", "reflex", "replan")
+_PHASES = ("shift", "swing", "settle")
 
 
 @dataclass(frozen=True)
@@ -43,11 +49,12 @@ class FootstepTime:
     wait_s: float
     stride_m: float
     advance_m: float
+    stretch_s: float = 0.0
 
     @property
     def duration_s(self) -> float:
-        """The footstep's whole time [s], waits included."""
-        return self.shift_s + self.swing_s + self.settle_s + self.wait_s
+        """The footstep's whole time [s], stretch and waits included."""
+        return self.shift_s + self.swing_s + self.stretch_s + self.settle_s + self.wait_s
 
 
 @dataclass(frozen=True)
@@ -77,9 +84,30 @@ class TimeBreakdown:
             **{f"{k}_fraction": v / total for k, v in self.shares_s.items()},
             "mean_shift_s": mean("shift_s"),
             "mean_swing_s": mean("swing_s"),
+            "mean_stretch_s": mean("stretch_s"),
             "mean_stride_m": mean("stride_m"),
             "mean_advance_m": mean("advance_m"),
         }
+
+
+def _fitted_lengths(log: RunLog) -> list[tuple[float, int, tuple[float, float]]]:
+    """(time [s], step, fitted (shift, swing) [s]) of every footstep's start, in time order.
+
+    Inf where the phase was not stretched or the ``step`` event does not say
+    (an older log, a footstep that was not fitted): none of that phase's
+    ticks then count as stretch (a phase's ticks can outnumber its
+    samples' time by one, where consecutive segments share a sample).
+    """
+    out = []
+    for e in log.events_of("step"):
+        fitted = e.get("fitted_s") or (None, None)
+        stretch = e.get("stretch_s") or (0.0, 0.0)
+        lengths = tuple(
+            float(f) if f is not None and (s or 0.0) > 1e-9 else np.inf
+            for f, s in zip(fitted[:2], stretch[:2], strict=True)
+        )
+        out.append((float(e["time"]), int(e.get("step") or 0), (lengths[0], lengths[1])))
+    return out
 
 
 def time_breakdown(log: RunLog, start_s: float, stop_s: float) -> TimeBreakdown:
@@ -88,8 +116,11 @@ def time_breakdown(log: RunLog, start_s: float, stop_s: float) -> TimeBreakdown:
     A tick counts towards the interval it starts. The ``phase`` column tells
     a footstep's shift (0), swing (1) and settle (2) from the holds, blends
     and recoveries (:data:`~roughwalk.sim.run_log.OTHER_PHASE`); the
-    ``mode`` column tells waits and reflexes. A footstep is a run of ticks
-    with one ``step`` number (the numbering restarts after a re-plan).
+    ``mode`` column tells waits, recoveries and re-plans. A footstep is a
+    run of ticks with one ``step`` number (the numbering restarts after a
+    re-plan); the ``step`` event that started it gives its shift's and
+    swing's fitted lengths (``fitted_s``), and their ticks past those count
+    as ``stretch``.
     """
     t = np.asarray(log["time"], dtype=float)
     shares = dict.fromkeys(_SHARES, 0.0)
@@ -101,9 +132,20 @@ def time_breakdown(log: RunLog, start_s: float, stop_s: float) -> TimeBreakdown:
     phase = np.asarray(log["phase"])
     step = np.asarray(log["step"])
     feet = np.asarray(log["feet_desired"], dtype=float)
-    wait, walk = MODES.index("wait"), MODES.index("walk")
+    wait, walk, recovery = MODES.index("wait"), MODES.index("walk"), MODES.index("recovery")
+    starts = _fitted_lengths(log)
     footsteps: list[FootstepTime] = []
     current: dict[str, Any] | None = None
+
+    def fitted_of(number: int, now: float) -> tuple[float, float]:
+        """The fitted lengths of the latest start of footstep ``number`` at or before ``now``."""
+        found = (np.inf, np.inf)
+        for when, n, lengths in starts:
+            if when > now + 1e-9:
+                break
+            if n == number:
+                found = lengths
+        return found
 
     def close(c: dict[str, Any] | None) -> None:
         if c is None:
@@ -119,6 +161,7 @@ def time_breakdown(log: RunLog, start_s: float, stop_s: float) -> TimeBreakdown:
                 wait_s=c["wait"],
                 stride_m=float(np.nanmax(moved)),
                 advance_m=float(np.linalg.norm(centroid)),
+                stretch_s=c["stretch"],
             )
         )
 
@@ -130,17 +173,27 @@ def time_breakdown(log: RunLog, start_s: float, stop_s: float) -> TimeBreakdown:
                 current["wait"] += d
             continue
         if modes[k] != walk or phase[k] in (OTHER_PHASE, -1):
-            shares["reflex"] += d
+            shares["reflex" if modes[k] == recovery else "replan"] += d
             close(current)
             current = None
             continue
-        name = ("shift", "swing", "settle")[int(phase[k])]
-        shares[name] += d
+        name = _PHASES[int(phase[k])]
         if current is None or current["step"] != int(step[k]):
             close(current)
-            current = dict.fromkeys(("shift", "swing", "settle", "wait"), 0.0)
-            current.update(step=int(step[k]), feet_start=feet[k])
-        current[name] += d
+            current = dict.fromkeys(("shift", "swing", "stretch", "settle", "wait"), 0.0)
+            fitted = fitted_of(int(step[k]), float(t[k]))
+            current.update(
+                step=int(step[k]),
+                feet_start=feet[k],
+                elapsed=dict.fromkeys(_PHASES, 0.0),
+                fitted={"shift": fitted[0], "swing": fitted[1], "settle": np.inf},
+            )
+        # A phase's fitted length comes first; its ticks past that are the stretch.
+        elapsed = current["elapsed"][name]
+        current["elapsed"][name] = elapsed + d
+        part = "stretch" if elapsed >= current["fitted"][name] - 1e-9 else name
+        current[part] += d
+        shares[part] += d
         current["feet_end"] = feet[k]
     close(current)
     return TimeBreakdown(float(sum(shares.values())), shares, footsteps)

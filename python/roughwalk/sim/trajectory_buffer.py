@@ -130,7 +130,7 @@ class Segment:
             kind="step",
             step=int(traj.step),
             ready_at=ready_at,
-            info={"leg": traj.leg, "valid": bool(traj.valid)},
+            info={"leg": traj.leg, "valid": bool(traj.valid), **_fitting(traj)},
         )
 
     def with_ready_at(self, ready_at: float) -> Segment:
@@ -180,6 +180,21 @@ class Segment:
     def last(self) -> DesiredState:
         """The final desired state."""
         return self.sample(self.duration)
+
+
+def _fitting(traj: Any) -> dict[str, list[float]]:
+    """A footstep's fitted shift and swing lengths [s], and how much longer they came out.
+
+    (:class:`~roughwalk.trajectories.step_report.StepReport`; NaN lengths
+    where the generator did not fit them.)
+    """
+    report = traj.report
+    fitted = [
+        float(getattr(report, "fitted_shift_s", np.nan)),
+        float(getattr(report, "fitted_swing_s", np.nan)),
+    ]
+    stretch = getattr(report, "stretch_s", (0.0, 0.0))
+    return {"fitted_s": fitted, "stretch_s": [float(stretch[0]), float(stretch[1])]}
 
 
 class TrajectoryBuffer:

@@ -791,7 +791,11 @@ class FootstepTrajectoryGenerator:
             nominal = prepared.nominal_timing(k).quantized(self.dt)
             if not result.valid and fitted != nominal:
                 result, state = self._attempts(prepared, k, start, nominal, began)
-            yield result
+            fitted_q = fitted.quantized(self.dt)
+            fitted_report = replace(
+                result.report, fitted_shift_s=fitted_q.shift_s, fitted_swing_s=fitted_q.swing_s
+            )
+            yield replace(result, report=fitted_report)
             start = next_start(state)
 
 

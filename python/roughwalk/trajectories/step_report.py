@@ -40,7 +40,13 @@ class StepReport:
     is the least of (limit − |q̇|) over joints and samples; ``zmp_margin_m``
     the least signed distance of the ZMP inside the support polygon.
     ``valid`` is False when the step stayed infeasible after every restart;
-    it is handed on all the same, as the paper does.
+    it is handed on all the same, as the paper does. ``fitted_shift_s`` and
+    ``fitted_swing_s`` are the phases' durations fitted before optimisation
+    (``timing.measured_speed``; the nominal timing where that is off, NaN
+    where the generator did not say): what the step's ``shift_s`` and
+    ``swing_s`` exceed them by is the stretch that the re-timing for joint
+    speed limits, the restarts (§5.3) and the fall-back to the nominal
+    timing added.
     """
 
     step: int
@@ -66,6 +72,16 @@ class StepReport:
     used_shortcut: bool
     chomp_status: str = ""
     notes: list[str] = field(default_factory=list)
+    fitted_shift_s: float = float("nan")
+    fitted_swing_s: float = float("nan")
+
+    @property
+    def stretch_s(self) -> tuple[float, float]:
+        """How much longer [s] the shift and the swing are than fitted (0 where unknown)."""
+        return (
+            max(self.shift_s - self.fitted_shift_s, 0.0) if self.fitted_shift_s >= 0 else 0.0,
+            max(self.swing_s - self.fitted_swing_s, 0.0) if self.fitted_swing_s >= 0 else 0.0,
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready fields (a NaN becomes None)."""
