@@ -691,14 +691,17 @@ mod tests {
         );
     }
 
+    /// A 13 cm mound centred at (0.3, 0): under the trunk of a stance placed there.
+    fn mound_under_trunk(x: f64, y: f64) -> f64 {
+        let r2 = (x - 0.3).powi(2) + y.powi(2);
+        (0.2 - 30.0 * r2).clamp(0.0, 0.13)
+    }
+
     #[test]
     fn footstep_certificate_from_a_given_pose_keeps_the_clearance_asked() {
         // The 13 cm mound under the trunk: the guessed pose's knees and trunk
         // touch it; searched from a pose 3 cm higher, the body is clear at once.
-        let height = |x: f64, y: f64| {
-            let r2 = (x - 0.3).powi(2) + y.powi(2);
-            (0.2 - 30.0 * r2).clamp(0.0, 0.13)
-        };
+        let height = mound_under_trunk;
         let (_, sdf) = sdf_of(height);
         let fixture = CertificateFixture::default();
         let search = fixture.search(&sdf, 0.0);
@@ -727,10 +730,7 @@ mod tests {
     fn footstep_certificate_lifts_the_body_off_a_bump_under_the_trunk() {
         // A 13 cm mound under the trunk, which the guessed pose's knees and
         // trunk touch: the obstacle step must lift the body clear.
-        let height = |x: f64, y: f64| {
-            let r2 = (x - 0.3).powi(2) + y.powi(2);
-            (0.2 - 30.0 * r2).clamp(0.0, 0.13)
-        };
+        let height = mound_under_trunk;
         let (_, sdf) = sdf_of(height);
         let fixture = CertificateFixture::default();
         let search = fixture.search(&sdf, 0.0);
