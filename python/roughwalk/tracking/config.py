@@ -249,6 +249,10 @@ class TrackingConfig:
     touchdown_depth_m:
         A swing aims this far [m] below the ground, so the foot touches down
         by the planned time instead of hovering.
+    swing_keep_level:
+        Drop the Raibert correction of a foothold where it would land the
+        foot on another terrain level than the planned foothold's (over a
+        pallet's side edge, 0.3 m down).
     """
 
     control_hz: float = 400.0
@@ -271,6 +275,7 @@ class TrackingConfig:
     terrain_swings: bool = True
     swing_clearance_m: float = 0.08
     touchdown_depth_m: float = 0.01
+    swing_keep_level: bool = False
     gains: TrackingGains = field(default_factory=TrackingGains)
     weights: TaskWeights = field(default_factory=TaskWeights)
     contact: ContactStateConfig = field(default_factory=ContactStateConfig)
