@@ -157,3 +157,30 @@ def test_swing_clears_the_pallet_and_lands_off_its_edge(anymal_c):
         v = [swing(t + k * e)[1] for k in (-1, 1)]
         np.testing.assert_allclose(swing(t)[1], (p[1] - p[0]) / (2 * e), atol=1e-5)
         np.testing.assert_allclose(swing(t)[2], (v[1] - v[0]) / (2 * e), atol=1e-3)
+
+
+def test_a_foothold_shift_over_a_pallet_s_side_edge_keeps_the_planned_level(anymal_c):
+    # Issue 10, double pallet task 2 at 0 iterations: RF planned on the upper
+    # pallet at its side edge; the Raibert shift of a base drifting
+    # right moved the target over the edge, and the foot landed 0.31 m lower,
+    # beside the pallet, and the robot rolled over it.
+    terrain = load_terrain("double_pallet")
+    planner = SwingPlanner(terrain, anymal_c.foot_radius)
+    ys = np.linspace(-1.0, 0.0, 2001)
+    side = ys[np.argmax(terrain.height(np.stack([np.full_like(ys, 1.8), ys], axis=1)) > 0.2)]
+    planned = np.array([1.8, side + 0.02, 0.31])
+    level = float(terrain.height(planned[None, :2])[0])
+    assert level > 0.3
+    shift = np.array([0.0, -0.08, 0.0])
+    # The shift alone puts the foot beside the pallet, on the ground.
+    assert terrain.height((planned + shift)[None, :2])[0] < 0.01
+    foothold = planner.foothold(planned, shift)
+    ring = foothold[:2] + (anymal_c.foot_radius + 0.03) * np.array(
+        [[math.cos(a), math.sin(a)] for a in np.linspace(0, 2 * math.pi, 24)]
+    )
+    # On the planned foothold's level, flat under the whole foot, at the foot's height.
+    np.testing.assert_allclose(terrain.height(ring), level, atol=0.01)
+    assert foothold[2] == pytest.approx(float(terrain.height(foothold[None, :2])[0]))
+    # A shift that stays on the level is kept.
+    inward = planner.foothold(planned, np.array([0.05, 0.06, 0.0]))
+    assert inward[:2] == pytest.approx(planned[:2] + (0.05, 0.06))

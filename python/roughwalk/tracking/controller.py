@@ -188,6 +188,7 @@ class WholeBodyController:
             else None
         )
         self._swings: list[SwingTrajectory | None] = [None] * 4
+        self._footholds = np.zeros((4, 3))
 
     # ---- one tick -------------------------------------------------------------------
 
@@ -272,12 +273,22 @@ class WholeBodyController:
             # Planned stance: a late foot keeps the swing it had.
             return current
         if current is None or current.t1 != end:
-            planned = self.reference(end).feet_pos[leg] + shift
-            target = self.swing_planner.foothold(planned)
-            target[2] -= self.config.touchdown_depth_m
+            self._footholds[leg] = self.reference(end).feet_pos[leg]
+            target = self._foothold(leg, shift)
             current = self.swing_planner.swing(foot, target, ref.t, end)
             self._swings[leg] = current
         return current
+
+    def _foothold(self, leg: int, shift: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The swing target [m] of ``leg``: its planned foothold corrected by ``shift``."""
+        assert self.swing_planner is not None
+        planned = self._footholds[leg]
+        if self.config.swing_keep_level:
+            target = self.swing_planner.foothold(planned, shift)
+        else:
+            target = self.swing_planner.foothold(planned + shift)
+        target[2] -= self.config.touchdown_depth_m
+        return target
 
     def _feet_on_ground(self) -> NDArray[np.bool_]:
         """(4,) the foot geom has a contact with the terrain (any force, even none)."""

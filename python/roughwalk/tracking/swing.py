@@ -136,9 +136,23 @@ class SwingPlanner:
         self._offsets = np.vstack([[0.0, 0.0], (rings[:, None, None] * dirs[None]).reshape(-1, 2)])
         self._side = foot_radius + 0.02
 
-    def foothold(self, planned: ArrayLike) -> NDArray[np.float64]:
-        """Where [m] to land for the ``planned`` (3,) foothold: off edges, on the ground."""
+    def foothold(self, planned: ArrayLike, shift: ArrayLike | None = None) -> NDArray[np.float64]:
+        """Where [m] to land for the ``planned`` (3,) foothold: off edges, on the ground.
+
+        ``shift`` (3,) [m] is a correction added to the planned foothold (the
+        controller's Raibert shift); it is dropped when it would put the foot
+        on another level than the planned foothold's own (a foothold near a
+        pallet's side edge shifted over it lands 0.3 m lower, beside the pallet).
+        """
         p = np.asarray(planned, dtype=float)
+        if shift is None:
+            return self._flat_spot(p)
+        own = self._flat_spot(p)
+        shifted = self._flat_spot(p + np.asarray(shift, dtype=float))
+        return shifted if abs(shifted[2] - own[2]) <= 2.0 * self.flatness else own
+
+    def _flat_spot(self, p: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The nearest flat spot [m] around ``p`` (3,), on the terrain's level at ``p`` if any."""
         level = float(self.terrain.height(p[None, :2])[0])
         centres = p[:2] + self._offsets
         points = (centres[:, None, :] + self._disk[None]).reshape(-1, 2)
