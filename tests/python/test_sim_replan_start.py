@@ -9,15 +9,17 @@ import pytest
 from numpy.typing import NDArray
 
 import roughwalk
+from roughwalk import _core
 from roughwalk.config import override
 from roughwalk.sim import CrawlSource
 from roughwalk.sim.config import SimConfig
 from roughwalk.sim.executor import Executor, later_legs
-from roughwalk.sim.footstep_source import PlanAttempt, PlanStart
+from roughwalk.sim.footstep_source import PlanAttempt, PlannerSource, PlanStart
 from roughwalk.sim.runner import Runner
 from roughwalk.sim.world import World
 
 LF, RF, LH, RH = range(4)
+HAVE_PLANNER = hasattr(_core, "FootstepPlanner")
 
 
 class OnlyOneLegSteps:
@@ -79,3 +81,22 @@ def test_a_replan_gives_the_measured_trunk_and_lets_another_leg_step_first(stand
     ok, source, event = replan(standing, from_trunk=False)
     assert not ok and event["start"] == "measured"
     assert [(s.next_leg, s.trunk) for s in source.starts] == [(LF, None)]
+
+
+@pytest.mark.skipif(not HAVE_PLANNER, reason="the Rust footstep planner is not built")
+def test_the_replan_event_gives_the_start_certificate_s_clearance(standing) -> None:
+    """Where the feet stand on flat ground the start needs no relaxing: the event says so."""
+    robot, terrain, measured = standing
+    source = PlannerSource(robot, terrain, expansions=2000)
+    executor = Executor(robot, terrain, source, config=SimConfig())
+    executor._reflex_next_leg = LF
+    ok, _ = executor._replan(
+        measured, executor._standing(measured), np.array([1.0, 0.0]), measured.time
+    )
+    event = executor.log.events[-1]
+    assert ok and event["start"] == "measured"
+    full = source.planner.config.certificate.clearance
+    assert event["start_clearance_m"] is not None and event["start_clearance_m"] >= full
+    # A source that certifies nothing (the crawl) has none to give.
+    _, _, crawl_event = replan(standing, from_trunk=True)
+    assert crawl_event["start_clearance_m"] is None

@@ -635,6 +635,7 @@ class Executor:
             charged_s=charged,
             next_leg=LEG_NAMES[next_leg] if next_leg is not None else None,
             start=start_from,
+            start_clearance_m=attempt.start_clearance_m if plan is not None else None,
             reason=attempt.reason if plan is None else "",
         )
         if plan is None:

@@ -79,13 +79,18 @@ class PlanAttempt:
     """What a source returned.
 
     The ``plan`` (None when it failed), its ``status``, a ``reason`` when it
-    failed, and the ``wall_s`` [s] it took.
+    failed, and the ``wall_s`` [s] it took. ``start_clearance_m`` is the start
+    certificate's body clearance [m] where the source certifies its start
+    (the footstep planner; None otherwise): below the planner's
+    ``certificate.clearance`` it says the start was certified only with the
+    relaxed ``certificate.start_clearance`` from the measured trunk.
     """
 
     plan: Any
     status: str
     reason: str
     wall_s: float
+    start_clearance_m: float | None = None
 
     @property
     def ok(self) -> bool:
@@ -272,7 +277,8 @@ class PlannerSource:
         if not result.solved:
             reason = result.reason or f"the planner found no plan ({result.status})"
             return PlanAttempt(None, result.status, reason, wall)
-        return PlanAttempt(result, result.status, "", wall)
+        start_clearance = None if result.initial_pose is None else result.initial_pose.clearance
+        return PlanAttempt(result, result.status, "", wall, start_clearance)
 
 
 def default_source(robot: Robot, terrain: Terrain, **options: Any) -> FootstepSource:
