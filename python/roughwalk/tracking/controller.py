@@ -188,7 +188,6 @@ class WholeBodyController:
             else None
         )
         self._swings: list[SwingTrajectory | None] = [None] * 4
-        self._footholds = np.zeros((4, 3))
 
     # ---- one tick -------------------------------------------------------------------
 
@@ -273,16 +272,16 @@ class WholeBodyController:
             # Planned stance: a late foot keeps the swing it had.
             return current
         if current is None or current.t1 != end:
-            self._footholds[leg] = self.reference(end).feet_pos[leg]
-            target = self._foothold(leg, shift)
+            target = self._foothold(self.reference(end).feet_pos[leg], shift)
             current = self.swing_planner.swing(foot, target, ref.t, end)
             self._swings[leg] = current
         return current
 
-    def _foothold(self, leg: int, shift: NDArray[np.float64]) -> NDArray[np.float64]:
-        """The swing target [m] of ``leg``: its planned foothold corrected by ``shift``."""
+    def _foothold(
+        self, planned: NDArray[np.float64], shift: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """The swing target [m] for the ``planned`` (3,) foothold corrected by ``shift``."""
         assert self.swing_planner is not None
-        planned = self._footholds[leg]
         if self.config.swing_keep_level:
             target = self.swing_planner.foothold(planned, shift)
         else:
