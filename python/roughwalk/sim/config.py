@@ -474,6 +474,14 @@ class ReflexConfig:
         Only then the planned footholds and ``replan_nudge_m``.
     max_reflexes:
         Give up (a failed run) after this many reflexes.
+    end_at_goal:
+        A recovery that settles with the feet's centroid within
+        ``outcome.goal_radius_m`` of a goal already reached ends the run
+        there instead of re-planning. Off, the robot re-plans from the goal
+        and walks on: on board AE (bench large rocks seed 5, ``--expansions
+        40000``) a reflex fired 0.1 s before the goal was reached, the
+        re-plan stepped on and the next one found RF on no foothold, and
+        the run that had reached the goal failed.
     """
 
     enabled: bool = True
@@ -496,6 +504,7 @@ class ReflexConfig:
     replan_nudge_m: float = 0.02
     replan_from_trunk: bool = True
     max_reflexes: int = 6
+    end_at_goal: bool = True
 
     def __post_init__(self) -> None:
         _positive(
