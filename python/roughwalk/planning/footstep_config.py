@@ -274,9 +274,12 @@ class FootstepConfig:
         --expansions 40000``, large rocks) the start put RF on a 7.5 cm
         rock's rim in seeds 2 and 3, which fell in the first swings;
         refused, and the foot moved onto the rock's top
-        (``executor.start_snap_m``), both walk without a reflex. Off by
-        default until then: alone, the bench re-placed the whole robot,
-        and board Y's sloped rocks seed 1 found no start in 18.
+        (``executor.start_snap_m``), both walk without a reflex. Opt-in
+        (session 14, ``--expansions 40000``, seeds 0–5): sloped rocks 4/6
+        → 6/6 (mean 5.66 → 7.05 cm/s, no reflex), large rocks 3/6 → 3/6
+        (seeds 2, 3, 4 against 0, 1, 4: new plans put LF on a 52° flank,
+        seed 1, and let LF slip 4.3 cm, seed 0), and on the 2-seed board
+        bench logs seed 1 falls at 1.33 s.
     edge_margin:
         How far beyond the foot's radius [m] a drop still counts. Larger keeps
         feet farther from rims, at the price of footholds near rocks.
@@ -290,7 +293,8 @@ class FootstepConfig:
         it refuses 37 % of board AE's footholds, and large rocks seed 1
         then finds no start in 18 (``--expansions 40000``); at 50° seed 1
         walks (4.98 cm/s; off, its plan put LF on a 52° flank, off which
-        it slid) but seeds 0 and 5 fall or stop as without it.
+        it slid), but seeds 0–5 still give 3 of 6 (1, 2, 3 against 2, 3,
+        4), after 4 reflexes against 1.
 
     """
 

@@ -612,15 +612,27 @@ class ExecutorConfig:
         barrier seed 0 fell at 0.42 L (RF's foot-force reflex stepping
         onto the barrier, then a roll over the right feet in the re-plan's
         first swing).
+    start_snap_m:
+        Where the nominal stance at the start pose puts a foot on no
+        foothold (a rock's rim, ``footstep.edge_drop``), that foot is put
+        on the nearest foothold within this distance [m] and the plan
+        starts from those feet (as a re-plan's feet are snapped); 0: the
+        start is refused. Larger puts the robot down farther from its
+        nominal stance.
     """
 
     compute_time_scale: float = 1.0
     initial_plan_s: float = 10.0
     plan_expansions: int = 0
     longest_step: float = 0.0
+    start_snap_m: float = 0.015
 
     def __post_init__(self) -> None:
-        _nonnegative(self, ("compute_time_scale", "plan_expansions", "longest_step"), "executor")
+        _nonnegative(
+            self,
+            ("compute_time_scale", "plan_expansions", "longest_step", "start_snap_m"),
+            "executor",
+        )
         _positive(self, ("initial_plan_s",), "executor")
 
 
