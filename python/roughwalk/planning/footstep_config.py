@@ -268,9 +268,9 @@ class FootstepConfig:
         (:func:`~roughwalk.planning.foothold_safety.edge_footholds`). 0 turns
         the check off. Smaller also refuses steep slopes (a drop d within
         r + margin is a slope of atan(d / (r + margin))); larger lets feet
-        onto the rims of lower rocks. At 3 cm it refuses 13 % of the learned
-        cost's footholds on the LittleDog board AE, 1 % on AC, 9 % on Y and
-        29 % on AD (the logs' flanks). On AE (``bench_littledog.py
+        onto the rims of lower rocks. At 3 cm it refuses 16 % of the learned
+        cost's footholds on the LittleDog board AE, 2 % on AC, 11 % on Y and
+        31 % on AD (the logs' flanks); at 4 cm none on Y, 26 % on AD. On AE (``bench_littledog.py
         --expansions 40000``, large rocks) the start put RF on a 7.5 cm
         rock's rim in seeds 2 and 3, which fell in the first swings;
         refused, and the foot moved onto the rock's top
