@@ -79,6 +79,13 @@ SHARE_HEADS = {
     "reflex": "reflx%",
     "replan": "replan%",
 }
+# Reasons of a run that did not start because of where the robot was put:
+# no certificate, a foot on no foothold, no footstep sequence out of the stance.
+NO_START = (
+    "no plan: start stance",
+    "no plan: start: foot",
+    "no plan: the planner found no plan (infeasible)",
+)
 # A reflex this soon [s] after the first motion counts as the start not holding.
 PLACEMENT_S = 0.1
 # Time limit [s] of every plan under --expansions: a cap the budget should reach first.
@@ -120,9 +127,14 @@ def stands_where_put(result: Any) -> bool:
     A reflex within :data:`PLACEMENT_S` of the first motion means the trunk
     had already tilted or slid while the robot settled before the clock
     started (board Y: a foot put on a steep rock face slid, tipping the trunk
-    12°), which a trial's operator would have seen and fixed.
+    12°), which a trial's operator would have seen and fixed. So is a start
+    with a foot where the planner allows none (``footstep.edge_drop``: on a
+    rock's rim, board AE, seeds 2 and 3, where RF slid off in the first
+    swings), and one from which the planner exhausts every footstep without
+    a plan (board AE, seed 5, nudged 3 cm right: ``infeasible`` after 0.01 s,
+    while the starts 3 cm forward are solved).
     """
-    if result.outcome.reason.startswith("no plan: start stance"):
+    if result.outcome.reason.startswith(NO_START):
         return False
     # The outcome's extra fields, not the flat JSON (read from there, the
     # first motion was always None, and every run that fell anywhere was

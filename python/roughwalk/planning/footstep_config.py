@@ -261,6 +261,40 @@ class FootstepConfig:
     cost_heading:
         Heading [rad] of the terrain cost map for a cost learned on oriented
         features (the map is computed once per terrain); ignored otherwise.
+    edge_drop:
+        A cell is no foothold where a foot resting on it has terrain more
+        than this [m] below its sole within ``edge_margin`` beyond its
+        radius: a rock's rim, off which a round foot slides
+        (:func:`~roughwalk.planning.foothold_safety.edge_footholds`). 0 turns
+        the check off. Smaller also refuses steep slopes (a drop d within
+        r + margin is a slope of atan(d / (r + margin))); larger lets feet
+        onto the rims of lower rocks. At 3 cm it refuses 16 % of the learned
+        cost's footholds on the LittleDog board AE, 2 % on AC, 11 % on Y and
+        31 % on AD (the logs' flanks); at 4 cm none on Y, 26 % on AD. On AE (``bench_littledog.py
+        --expansions 40000``, large rocks) the start put RF on a 7.5 cm
+        rock's rim in seeds 2 and 3, which fell in the first swings;
+        refused, and the foot moved onto the rock's top
+        (``executor.start_snap_m``), both walk without a reflex. Opt-in
+        (session 14, ``--expansions 40000``, seeds 0–5): sloped rocks 4/6
+        → 6/6 (mean 5.66 → 7.05 cm/s, no reflex), large rocks 3/6 → 3/6
+        (seeds 2, 3, 4 against 0, 1, 4: new plans put LF on a 52° flank,
+        seed 1, and let LF slip 4.3 cm, seed 0), and on the 2-seed board
+        bench logs seed 1 falls at 1.33 s.
+    edge_margin:
+        How far beyond the foot's radius [m] a drop still counts. Larger keeps
+        feet farther from rims, at the price of footholds near rocks.
+    max_foothold_slope:
+        A cell is no foothold where the terrain's mean slope over the foot's
+        disc is steeper than this [rad]
+        (:func:`~roughwalk.planning.foothold_safety.steep_footholds`): a foot
+        pressed down vertically slides beyond the friction cone, atan μ
+        (45° at μ = 1). π/2 turns the check off. Smaller keeps a margin to
+        the cone and refuses more of a rocky board. Off by default: at 45°
+        it refuses 37 % of board AE's footholds, and large rocks seed 1
+        then finds no start in 18 (``--expansions 40000``); at 50° seed 1
+        walks (4.98 cm/s; off, its plan put LF on a 52° flank, off which
+        it slid), but seeds 0–5 still give 3 of 6 (1, 2, 3 against 2, 3,
+        4), after 4 reflexes against 1.
 
     """
 
@@ -288,6 +322,9 @@ class FootstepConfig:
     sdf_resolution: float = 0.005
     sdf_z_margin: float = 0.25
     cost_heading: float = 0.0
+    edge_drop: float = 0.0
+    edge_margin: float = 0.0
+    max_foothold_slope: float = math.pi / 2
 
     def __post_init__(self) -> None:
         _check("resolution", self.resolution, strict=True)
@@ -332,6 +369,9 @@ class FootstepConfig:
         ):
             _check(name, float(getattr(self, name)), strict=True)
         _check("sdf_z_margin", self.sdf_z_margin)
+        _check("edge_drop", self.edge_drop)
+        _check("edge_margin", self.edge_margin)
+        _check("max_foothold_slope", self.max_foothold_slope)
         if not math.isfinite(self.crossing_margin) or not math.isfinite(self.cost_heading):
             raise ConfigError("footstep.crossing_margin and footstep.cost_heading must be finite")
         if self.incircle_preferred < self.incircle_min:
@@ -426,6 +466,13 @@ class FootstepConfig:
         d = dataclasses.asdict(self)
         d["walking_order"] = [LEG_INDEX[name] for name in self.walking_order]
         d["actions"] = [tuple(a) for a in self.actions]
-        for key in ("sdf_resolution", "sdf_z_margin", "cost_heading"):
+        for key in (
+            "sdf_resolution",
+            "sdf_z_margin",
+            "cost_heading",
+            "edge_drop",
+            "edge_margin",
+            "max_foothold_slope",
+        ):
             d.pop(key)
         return d

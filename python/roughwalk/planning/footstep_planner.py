@@ -23,6 +23,7 @@ from numpy.typing import ArrayLike
 
 from roughwalk import _core
 from roughwalk.errors import InvalidArgumentError, PlanningError, TerrainError
+from roughwalk.planning.foothold_safety import unsafe_footholds
 from roughwalk.planning.footstep_config import LEG_INDEX, FootstepConfig
 from roughwalk.planning.footstep_cost import FootholdCost, default_terrain_cost
 from roughwalk.planning.footstep_plan import (
@@ -101,6 +102,14 @@ class FootstepPlanner:
                 f"the terrain cost cannot be evaluated on {terrain}: {e}. Pass a cost that "
                 "suits this grid (cost=..., or --cost FILE with features learned at larger radii)"
             ) from None
+        c = self.config
+        if c.edge_drop > 0 or c.max_foothold_slope < 0.5 * np.pi:
+            # Rims and slopes a round foot slides off are no footholds.
+            unsafe = unsafe_footholds(
+                terrain, robot.foot_radius, c.edge_drop, c.edge_margin, c.max_foothold_slope
+            )
+            self.cost_front = np.where(unsafe, np.inf, self.cost_front)
+            self.cost_hind = np.where(unsafe, np.inf, self.cost_hind)
         t2 = time.perf_counter()
         collision = CollisionModel.from_robot(robot)
         body = ~collision.is_foot

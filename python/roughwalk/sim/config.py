@@ -474,6 +474,14 @@ class ReflexConfig:
         Only then the planned footholds and ``replan_nudge_m``.
     max_reflexes:
         Give up (a failed run) after this many reflexes.
+    end_at_goal:
+        A recovery that settles with the feet's centroid within
+        ``outcome.goal_radius_m`` of a goal already reached ends the run
+        there instead of re-planning. Off, the robot re-plans from the goal
+        and walks on: on board AE (bench large rocks seed 5, ``--expansions
+        40000``) a reflex fired 0.1 s before the goal was reached, the
+        re-plan stepped on and the next one found RF on no foothold, and
+        the run that had reached the goal failed.
     """
 
     enabled: bool = True
@@ -496,6 +504,7 @@ class ReflexConfig:
     replan_nudge_m: float = 0.02
     replan_from_trunk: bool = True
     max_reflexes: int = 6
+    end_at_goal: bool = True
 
     def __post_init__(self) -> None:
         _positive(
@@ -603,15 +612,27 @@ class ExecutorConfig:
         barrier seed 0 fell at 0.42 L (RF's foot-force reflex stepping
         onto the barrier, then a roll over the right feet in the re-plan's
         first swing).
+    start_snap_m:
+        Where the nominal stance at the start pose puts a foot on no
+        foothold (a rock's rim, ``footstep.edge_drop``), that foot is put
+        on the nearest foothold within this distance [m] and the plan
+        starts from those feet (as a re-plan's feet are snapped); 0: the
+        start is refused. Larger puts the robot down farther from its
+        nominal stance.
     """
 
     compute_time_scale: float = 1.0
     initial_plan_s: float = 10.0
     plan_expansions: int = 0
     longest_step: float = 0.0
+    start_snap_m: float = 0.015
 
     def __post_init__(self) -> None:
-        _nonnegative(self, ("compute_time_scale", "plan_expansions", "longest_step"), "executor")
+        _nonnegative(
+            self,
+            ("compute_time_scale", "plan_expansions", "longest_step", "start_snap_m"),
+            "executor",
+        )
         _positive(self, ("initial_plan_s",), "executor")
 
 

@@ -313,6 +313,10 @@ class Executor:
                 if mode == "recovery" and not self._settled(measured, now):
                     # Still rocking: hold a little longer before lifting a foot.
                     self.buffer.append(hold_segment(desired, _SETTLE_TICK_S, now, "recovery"))
+                elif mode == "recovery" and self._at_goal(monitor, measured):
+                    # Recovered on four feet inside the goal radius: the run is done.
+                    log.event(now, "settled_at_goal")
+                    break
                 elif mode == "recovery":
                     # Settled on four feet: re-plan from where they stand (§6, §4.5).
                     replans += 1
@@ -424,6 +428,17 @@ class Executor:
         log.event(end, "end", success=outcome.success, reason=outcome.reason)
         log.meta["outcome"] = outcome.to_dict()
         return outcome
+
+    def _at_goal(self, monitor: OutcomeMonitor, measured: MeasuredState) -> bool:
+        """Whether a recovered robot may stop: it reached the goal and its feet are still there.
+
+        With ``reflex.end_at_goal``: the goal was reached (``monitor.reached_at``)
+        and the feet's centroid is within ``outcome.goal_radius_m`` of it.
+        """
+        if not self.config.reflex.end_at_goal or monitor.reached_at is None:
+            return False
+        centroid = measured.feet_centroid[:2]
+        return bool(np.linalg.norm(centroid - monitor.goal) <= self.config.outcome.goal_radius_m)
 
     def _schedule_next(self, now: float) -> None:
         """Footstep k started: optimise k+1 now, ready after its charged wall time."""

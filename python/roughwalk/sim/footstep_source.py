@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 
 from roughwalk.errors import InvalidArgumentError
 from roughwalk.robots.canonical_frame import LEG_NAMES
+from roughwalk.sim.config import ExecutorConfig
 from roughwalk.sim.foothold_snap import snap_to_footholds
 from roughwalk.trajectories.body_keyframes import nominal_fit, pose_over_support
 from roughwalk.trajectories.whole_body import WholeBody
@@ -237,6 +238,10 @@ class PlannerSource:
     expansions:
         A budget of expanded states on top of the time limit: the planner's
         deterministic mode (same inputs and budget, same plan), for tests.
+    start_snap_m:
+        How far [m] a foot of the nominal stance at a start pose that falls
+        on no foothold may move onto the nearest one
+        (:attr:`~roughwalk.sim.config.ExecutorConfig.start_snap_m`).
     options:
         Passed on to :class:`~roughwalk.planning.footstep_planner.FootstepPlanner`.
     """
@@ -244,13 +249,19 @@ class PlannerSource:
     name = "planner"
 
     def __init__(
-        self, robot: Robot, terrain: Terrain, expansions: int | None = None, **options: Any
+        self,
+        robot: Robot,
+        terrain: Terrain,
+        expansions: int | None = None,
+        start_snap_m: float = ExecutorConfig.start_snap_m,
+        **options: Any,
     ) -> None:
         from roughwalk.planning.footstep_planner import FootstepPlanner
 
         self.robot = robot
         self.terrain = terrain
         self.expansions = expansions
+        self.start_snap_m = start_snap_m
         self.planner = FootstepPlanner(robot, terrain, **options)
 
     def plan(self, start: PlanStart, goal: NDArray[np.float64], time_limit: float) -> PlanAttempt:
@@ -261,6 +272,21 @@ class PlannerSource:
             result = self.planner.plan(
                 start.pose, g, time_limit=time_limit, expansions=self.expansions
             )
+            if self.start_snap_m > 0 and "not on a foothold" in (result.reason or ""):
+                # Put down with a foot on no foothold (a rock's rim): that foot
+                # goes onto the nearest foothold, the walk starts from there.
+                feet = self._stance_at(start.pose)
+                snapped, moved = snap_to_footholds(
+                    self.planner, self.terrain, feet, self.start_snap_m
+                )
+                if moved:
+                    result = self.planner.replan(
+                        snapped,
+                        self.planner.config.walking_order[0],
+                        goal=g,
+                        time_limit=time_limit,
+                        expansions=self.expansions,
+                    )
         else:
             assert start.feet is not None
             leg = LEG_NAMES[start.next_leg] if start.next_leg is not None else "LH"
@@ -279,6 +305,17 @@ class PlannerSource:
             return PlanAttempt(None, result.status, reason, wall)
         start_clearance = None if result.initial_pose is None else result.initial_pose.clearance
         return PlanAttempt(result, result.status, "", wall, start_clearance)
+
+    def _stance_at(self, pose: tuple[float, float, float]) -> NDArray[np.float64]:
+        """The nominal stance's feet (4, 3) [m] at the trunk pose (x, y, yaw), on the terrain."""
+        x, y, yaw = pose
+        c, s = math.cos(yaw), math.sin(yaw)
+        local = np.asarray(self.robot.nominal_stance.feet, dtype=float)[:, :2]
+        xy = np.column_stack(
+            (x + c * local[:, 0] - s * local[:, 1], y + s * local[:, 0] + c * local[:, 1])
+        )
+        z = np.asarray(self.terrain.height(xy), dtype=float) + self.robot.foot_radius
+        return np.column_stack((xy, z))
 
 
 def default_source(robot: Robot, terrain: Terrain, **options: Any) -> FootstepSource:

@@ -157,7 +157,7 @@ def run(
     for d in disturbances:
         seen = d.planner_terrain(seen)
     budget = cfg.executor.plan_expansions or None
-    options: dict[str, Any] = {"expansions": budget}
+    options: dict[str, Any] = {"expansions": budget, "start_snap_m": cfg.executor.start_snap_m}
     if cfg.executor.longest_step > 0:
         options["config"] = longer_step_config(robot_obj, cfg.executor.longest_step)
     if isinstance(planner, str):

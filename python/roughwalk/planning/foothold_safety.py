@@ -1,0 +1,103 @@
+"""Footholds a round foot slides off: a rock's rim, and slopes beyond the friction cone.
+
+The learned terrain cost (Zucker 2011, §4.2) hardly tells such footholds
+from their neighbours: its quadratic fits over discs of 1–6 cm smooth a
+7 cm cliff into a slope, and on the LittleDog large-rocks board (AE) the
+footholds with a drop of over 3 cm beside them cost a median 2.33 against
+1.58 for the others. The bench's large
+rocks runs fell from both kinds:
+
+- **on a rim** (seeds 2 and 3): the start put RF on the rim of a 7.5 cm
+  rock, its centre 3 mm outside the top; as LF (seed 2) or RH (seed 3)
+  swung, RF slid 3.5 cm down the rock and the trunk tipped over;
+- **on a slope** (seed 1 with the rims refused): the plan put LF on a 52°
+  flank; it slid off as RF swung, and the robot rolled over. A foot
+  pressed down vertically slides where the slope is steeper than the
+  friction cone, atan μ (45° at μ = 1).
+
+:func:`edge_footholds` marks the terrain cells where a foot of radius r
+would rest with terrain more than ``drop`` below its sole within r +
+``margin`` of its centre. The resting height is that of the sphere lowered
+onto the height field, max over the disc of h(p) + √(r² − |p − c|²) − r; a
+foot on the floor beside a wall rests on the floor and is not on an edge,
+one on top of the wall within r of its rim is. :func:`steep_footholds`
+marks the cells whose mean slope over the foot's disc exceeds a limit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import ndimage
+
+from roughwalk.terrain.terrain import Terrain
+
+__all__ = ["edge_footholds", "resting_height", "steep_footholds", "unsafe_footholds"]
+
+
+def _disc(radius: float, dx: float, dy: float) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
+    """The grid offsets within ``radius`` [m]: a footprint mask and their squared distances [m²]."""
+    ni = max(int(np.ceil(radius / dx)), 0)
+    nj = max(int(np.ceil(radius / dy)), 0)
+    i, j = np.mgrid[-ni : ni + 1, -nj : nj + 1]
+    d2 = (i * dx) ** 2 + (j * dy) ** 2
+    return d2 <= radius * radius + 1e-15, d2
+
+
+def resting_height(terrain: Terrain, foot_radius: float) -> NDArray[np.float64]:
+    """Height [m] of the sole of a sphere of ``foot_radius`` [m] lowered onto each grid cell.
+
+    (nx, ny), x-major like ``terrain.heights`` (unknown cells as that fills
+    them): max over the cells p within the radius of h(p) + √(r² − |p − c|²) − r.
+    """
+    h = np.asarray(terrain.heights, dtype=float)
+    inside, d2 = _disc(foot_radius, terrain.dx, terrain.dy)
+    bump = np.where(inside, np.sqrt(np.maximum(foot_radius**2 - d2, 0.0)) - foot_radius, 0.0)
+    return np.asarray(
+        ndimage.grey_dilation(h, footprint=inside, structure=bump, mode="nearest"), dtype=float
+    )
+
+
+def edge_footholds(
+    terrain: Terrain, foot_radius: float, drop: float, margin: float = 0.0
+) -> NDArray[np.bool_]:
+    """Cells (nx, ny) where a foot would rest with a drop of more than ``drop`` [m] beside it.
+
+    A cell is on an edge when, within ``foot_radius`` + ``margin`` [m] of it,
+    the terrain lies more than ``drop`` below the sole of the foot resting
+    there (:func:`resting_height`). ``drop`` ≤ 0 marks none.
+    """
+    shape = np.asarray(terrain.heights).shape
+    if drop <= 0:
+        return np.zeros(shape, dtype=bool)
+    rest = resting_height(terrain, foot_radius)
+    h = np.asarray(terrain.heights, dtype=float)
+    footprint, _ = _disc(foot_radius + margin, terrain.dx, terrain.dy)
+    low = ndimage.minimum_filter(h, footprint=footprint, mode="nearest")
+    return np.asarray(rest - low > drop, dtype=bool)
+
+
+def steep_footholds(terrain: Terrain, foot_radius: float, max_slope: float) -> NDArray[np.bool_]:
+    """Cells (nx, ny) steeper than ``max_slope`` [rad]: the mean gradient over the foot's disc.
+
+    ``max_slope`` ≥ π/2 marks none.
+    """
+    shape = np.asarray(terrain.heights).shape
+    if max_slope >= 0.5 * np.pi:
+        return np.zeros(shape, dtype=bool)
+    h = np.asarray(terrain.heights, dtype=float)
+    gx, gy = np.gradient(h, terrain.dx, terrain.dy)
+    inside, _ = _disc(foot_radius, terrain.dx, terrain.dy)
+    mean = inside / inside.sum()
+    mx = ndimage.convolve(gx, mean, mode="nearest")
+    my = ndimage.convolve(gy, mean, mode="nearest")
+    return np.asarray(np.hypot(mx, my) > np.tan(max_slope), dtype=bool)
+
+
+def unsafe_footholds(
+    terrain: Terrain, foot_radius: float, drop: float, margin: float, max_slope: float
+) -> NDArray[np.bool_]:
+    """Cells (nx, ny) on an edge (:func:`edge_footholds`) or too steep (:func:`steep_footholds`)."""
+    return edge_footholds(terrain, foot_radius, drop, margin) | steep_footholds(
+        terrain, foot_radius, max_slope
+    )

@@ -1,0 +1,130 @@
+"""Footholds a foot slides off are refused: rims and slopes beyond the friction cone (issue 7).
+
+On board AE (``bench_littledog.py --expansions 40000``, large rocks seeds 2
+and 3) the bench's start put RF on the rim of a 7.5 cm rock, its centre
+3 mm outside the top; as LF (seed 2) or RH (seed 3) swung, RF slid 3.5 cm
+down the rock and the robot fell within 1.7 s (``footstep.edge_drop``).
+With the rims refused, seed 1's plan put LF on a 52° flank, off which it
+slid (``footstep.max_foothold_slope``, opt-in: at 45° no start of that
+seed holds). The learned cost took both for footholds like their neighbours.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+import roughwalk as rw
+from roughwalk.planning import FootstepConfig, FootstepPlanner
+from roughwalk.planning.foothold_safety import edge_footholds, resting_height, steep_footholds
+from roughwalk.terrain import Terrain
+
+R = 0.0095  # LittleDog's foot radius [m]
+DX = 0.001
+
+
+def _rock_and_slope() -> Terrain:
+    """Flat floor at 0, a 7.5 cm box rock (x ≥ 0.16, y < 0.16), a 30° ramp up from y = 0.16."""
+    x = np.arange(0.0, 0.32, DX)
+    xx, yy = np.meshgrid(x, x, indexing="ij")
+    h = np.where((xx >= 0.16) & (yy < 0.16), 0.075, 0.0)
+    h = np.where(yy >= 0.16, (yy - 0.16) * np.tan(np.radians(30.0)), h)
+    return Terrain(h, x0=0.0, y0=0.0, dx=DX, dy=DX, name="rim")
+
+
+def _cell(t: Terrain, x: float, y: float) -> tuple[int, int]:
+    return int(round((x - t.x0) / t.dx)), int(round((y - t.y0) / t.dy))
+
+
+def test_a_foot_near_a_rim_is_on_an_edge_beside_the_wall_and_on_a_slope_it_is_not() -> None:
+    t = _rock_and_slope()
+    edges = edge_footholds(t, R, drop=0.03)
+    rest = resting_height(t, R)
+    # Centre 3 mm outside the top: the foot rests on the rim's corner.
+    outside = _cell(t, 0.157, 0.08)
+    assert rest[outside] > 0.07
+    assert edges[outside]
+    # Centre 5 mm inside the top: resting flat on it, the floor 7.5 cm down within r.
+    assert edges[_cell(t, 0.165, 0.08)]
+    # Far inside the top, on the floor beside the wall (resting on the floor),
+    # on the open floor and on the 30° ramp: no edge.
+    for x, y in ((0.24, 0.08), (0.145, 0.08), (0.08, 0.08), (0.08, 0.24)):
+        assert not edges[_cell(t, x, y)], (x, y)
+    # The margin reaches farther in from the rim; drop 0 marks nothing.
+    inside = _cell(t, 0.172, 0.08)
+    assert not edges[inside]
+    assert edge_footholds(t, R, drop=0.03, margin=0.005)[inside]
+    assert not edge_footholds(t, R, drop=0.0).any()
+
+
+def test_the_planner_refuses_a_foothold_on_the_rim_and_keeps_the_floor_and_ramp(
+    littledog: rw.Robot,
+) -> None:
+    t = _rock_and_slope()
+    on = FootstepPlanner(littledog, t, FootstepConfig.for_robot(littledog, edge_drop=0.03))
+    off = FootstepPlanner(littledog, t, FootstepConfig.for_robot(littledog, edge_drop=0.0))
+    i, j = _cell(t, 0.157, 0.08)
+    assert np.isfinite(off.cost_front[i, j]) and np.isfinite(off.cost_hind[i, j])
+    assert np.isinf(on.cost_front[i, j]) and np.isinf(on.cost_hind[i, j])
+    # The floor and the ramp keep the learned cost.
+    for x, y in ((0.08, 0.08), (0.08, 0.24)):
+        k = _cell(t, x, y)
+        assert on.cost_front[k] == off.cost_front[k]
+
+
+def test_a_slope_steeper_than_the_friction_cone_is_steep_and_a_gentler_one_is_not() -> None:
+    x = np.arange(0.0, 0.32, DX)
+    xx, yy = np.meshgrid(x, x, indexing="ij")
+    # Ramps up along x: 30° for y < 0.16, 50° beyond.
+    slope = np.where(yy < 0.16, np.radians(30.0), np.radians(50.0))
+    t = Terrain(xx * np.tan(slope), x0=0.0, y0=0.0, dx=DX, dy=DX, name="ramps")
+    steep = steep_footholds(t, R, np.radians(45.0))
+    assert not steep[_cell(t, 0.15, 0.08)]
+    assert steep[_cell(t, 0.15, 0.24)]
+    assert not steep_footholds(t, R, np.radians(55.0))[_cell(t, 0.15, 0.24)]
+    assert not steep_footholds(t, R, 0.5 * np.pi).any()
+    robot = rw.load_robot("littledog")
+    on = FootstepPlanner(
+        robot, t, FootstepConfig.for_robot(robot, max_foothold_slope=np.radians(45.0))
+    )
+    assert np.isfinite(on.cost_front[_cell(t, 0.15, 0.08)])
+    assert np.isinf(on.cost_front[_cell(t, 0.15, 0.24)])
+
+
+@pytest.fixture(scope="module")
+def board_ae(littledog_board: Callable[[str], Terrain]) -> Terrain:
+    return littledog_board("AE")
+
+
+def test_the_bench_start_with_rf_on_a_rock_rim_of_board_ae_is_refused(
+    littledog: rw.Robot, board_ae: Terrain
+) -> None:
+    # Large rocks seed 2's start (bench_littledog.course): RF on the rim.
+    start = (0.16046448536997265, 0.30046982286828244, 0.03142257405942804)
+    goal = (0.459, 0.3045)
+    planner = FootstepPlanner(
+        littledog, board_ae, FootstepConfig.for_robot(littledog, edge_drop=0.03)
+    )
+    refused = planner.plan(start, goal, time_limit=None, expansions=10)
+    assert refused.status == "invalid_input"
+    assert "foot RF" in (refused.reason or "") and "not on a foothold" in (refused.reason or "")
+    off = FootstepPlanner(littledog, board_ae, FootstepConfig.for_robot(littledog, edge_drop=0.0))
+    assert off.plan(start, goal, time_limit=None, expansions=10).status != "invalid_input"
+
+
+def test_the_52_degree_flank_large_rocks_seed_1_planned_lf_onto_is_refused(
+    littledog: rw.Robot, board_ae: Terrain
+) -> None:
+    # LF's planned contact (step 9 of seed 1's plan, start nudged 3 cm right),
+    # where LF slid off as RF swung and the robot rolled over.
+    i, j = _cell(board_ae, 0.4495, 0.3535)
+    on = FootstepPlanner(
+        littledog,
+        board_ae,
+        FootstepConfig.for_robot(littledog, edge_drop=0.03, max_foothold_slope=0.785),
+    )
+    off = FootstepPlanner(littledog, board_ae, FootstepConfig.for_robot(littledog, edge_drop=0.03))
+    assert np.isfinite(off.cost_front[i, j])
+    assert np.isinf(on.cost_front[i, j])
