@@ -537,6 +537,17 @@ class TrajoptConfig:
         Names of the constraints to use (see :mod:`roughwalk.trajopt.constraints`).
         ``force_between_nodes`` (opt-in, appended last) keeps the forces
         unilateral and inside the friction pyramid between the force nodes too.
+        ``joint_torques`` (opt-in) bounds the joint torques the stance
+        forces ask of the legs (:mod:`~roughwalk.trajopt.constraints.joint_torques`).
+    joint_torque_margin:
+        Share of each joint's torque limit the ``joint_torques`` rows allow
+        (1 the full limit). Below 1 leaves the tracking controller torque
+        for the legs' own weight and its feedback, at the price of plans
+        that lean on fewer, more evenly loaded legs (or none at all).
+    dt_joint_torques:
+        Interval [s] between the samples of the ``joint_torques`` rows
+        (12 rows per sample). Shorter bounds the torques between samples
+        more tightly at the price of more rows.
     costs:
         Cost weights (:class:`CostWeights`).
     swing_clearance:
@@ -585,6 +596,8 @@ class TrajoptConfig:
     dt_dynamics: float = 0.1
     dt_range_of_motion: float = 0.08
     constraints: tuple[str, ...] = MELON_REACH_CONSTRAINTS
+    joint_torque_margin: float = 1.0
+    dt_joint_torques: float = 0.04
     costs: CostWeights = field(default_factory=CostWeights)
     swing_clearance: float = 0.08
     base_clearance: float = 0.7
@@ -605,7 +618,14 @@ class TrajoptConfig:
             raise ConfigError(
                 f"phase_duration_bounds must be 0 < min < max [s], got {self.phase_duration_bounds}"
             )
-        for name in ("base_poly_duration", "dt_dynamics", "dt_range_of_motion", "sample_rate_hz"):
+        for name in (
+            "base_poly_duration",
+            "dt_dynamics",
+            "dt_range_of_motion",
+            "dt_joint_torques",
+            "sample_rate_hz",
+            "joint_torque_margin",
+        ):
             if not getattr(self, name) > 0:
                 raise ConfigError(f"{name} must be > 0, got {getattr(self, name)}")
         for name in ("foot_polys_per_swing", "force_polys_per_stance"):
@@ -633,6 +653,8 @@ class TrajoptConfig:
                 "dt_dynamics",
                 "dt_range_of_motion",
                 "constraints",
+                "joint_torque_margin",
+                "dt_joint_torques",
                 "costs",
                 "swing_clearance",
                 "base_clearance",

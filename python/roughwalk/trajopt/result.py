@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from roughwalk.errors import PlanningError
 from roughwalk.robots._rotations import matrix_to_quat
 from roughwalk.trajopt.gaits import ContactSchedule
+from roughwalk.trajopt.leg_statics import LegStatics
 from roughwalk.trajopt.robot_model import SingleRigidBody
 from roughwalk.trajopt.solver import TrajoptStatus
 from roughwalk.trajopt.task import Task
@@ -352,6 +353,9 @@ class TrajoptResult:
                     if body.get("reach_centres") is None
                     else tuple(tuple(r) for r in body["reach_centres"]),  # type: ignore[arg-type]
                     reach_radius=body.get("reach_radius"),
+                    legs=None
+                    if body.get("legs") is None
+                    else tuple(LegStatics.from_dict(leg) for leg in body["legs"]),  # type: ignore[arg-type]
                 )
                 if body
                 else None,

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from roughwalk.errors import InvalidArgumentError
+from roughwalk.trajopt.leg_statics import LegStatics, leg_statics_from_robot
 
 if TYPE_CHECKING:
     from roughwalk.robots import Robot
@@ -67,6 +68,10 @@ class SingleRigidBody:
         relative to the centre of mass). The box alone cannot say this: its
         lower corners lie beyond a real leg's stretch (see
         :func:`leg_reach_sphere`). None (TOWR's model) means the box only.
+    legs:
+        Each leg's geometry and torque limits (:class:`LegStatics`, canonical
+        order), for the ``joint_torques`` constraint; None (TOWR's model, or
+        legs of another kind) leaves that constraint without rows.
 
     """
 
@@ -80,6 +85,7 @@ class SingleRigidBody:
     com_in_base: Vec3 = (0.0, 0.0, 0.0)
     reach_centres: tuple[Vec3, Vec3, Vec3, Vec3] | None = None
     reach_radius: float | None = None
+    legs: tuple[LegStatics, LegStatics, LegStatics, LegStatics] | None = None
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.mass) and self.mass > 0):
@@ -149,6 +155,7 @@ class SingleRigidBody:
             if self.reach_centres is None
             else [list(r) for r in self.reach_centres],
             "reach_radius": self.reach_radius,
+            "legs": None if self.legs is None else [leg.to_dict() for leg in self.legs],
         }
 
 
@@ -259,6 +266,7 @@ def rigid_body_from_robot(robot: Robot, **overrides: object) -> SingleRigidBody:
     box = _BOX_PER_LEG_LENGTH * leg_length
     sphere = leg_reach_sphere(robot)
     centres: tuple[Vec3, Vec3, Vec3, Vec3] | None = None
+    legs = leg_statics_from_robot(robot)
     if sphere is not None:
         # Centres for contact points relative to the CoM (foot centre = contact + r_foot e_z).
         o = sphere[0] - com - np.array([0.0, 0.0, robot.foot_radius])
@@ -274,6 +282,7 @@ def rigid_body_from_robot(robot: Robot, **overrides: object) -> SingleRigidBody:
         com_in_base=_tuple3(com),
         reach_centres=centres,
         reach_radius=None if sphere is None else sphere[1],
+        legs=None if legs is None else (legs[0], legs[1], legs[2], legs[3]),
     )
     return body.with_changes(**overrides) if overrides else body
 
