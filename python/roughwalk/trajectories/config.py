@@ -538,6 +538,22 @@ class SwingConfig:
         the default: the ``"joint"`` law itself, against ``"even"`` with
         the same settings, is slower on round rocks (5.76), logs (6.08) and
         large rocks (3.80).
+    lift_off_reach:
+        Where the foot about to lift is out of the leg's reach under the
+        trunk the preview controller planned for lift-off, lower and tilt
+        the trunk there until it is reached (as at touchdown for the
+        landing foot; Zucker 2011, §3.2 without the horizontal push). The
+        preview leads the trunk ahead of the swing pose the planner
+        certified (1.1 cm at a 12.6 cm stride), which the trailing foot of
+        a long stride's last crawl step (RF) then misses: that step was
+        invalid at its fitted timing and fell back to its nominal one,
+        stretched (0.08 + 0.24 s → 0.62 + 0.44 s). Flat 0.8 m, joint swing
+        options (``time_law`` and ``path`` "joint", ``ramp_fraction`` 0.1),
+        ``executor.longest_step`` 0.4 / 0.45: 7.40 → 9.02 / 6.59 → 9.18
+        cm/s (stretch 2.5 → 0.5 s / 3.8 → 0.5 s); at the default 0.3 L
+        9.25 either way (only a straight crawl's last step, or one with
+        10 cm strides and more, needs it). Off by default: longer strides
+        are opt-in.
     """
 
     lift_height: float = 0.03
@@ -548,6 +564,7 @@ class SwingConfig:
     vertical_weight: float = 1.5
     ramp_fraction: float = 0.2
     path: str = "cartesian"
+    lift_off_reach: bool = False
 
     def __post_init__(self) -> None:
         _check_nonnegative(self, ("lift_height", "clearance"), "swing")
