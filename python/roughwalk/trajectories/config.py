@@ -554,6 +554,13 @@ class SwingConfig:
         9.25 either way (only a straight crawl's last step, or one with
         10 cm strides and more, needs it). Off by default: longer strides
         are opt-in.
+    fast_swing_relief:
+        Swings whose ground, under the foot's straight path and a foot
+        radius either side, varies by at most this [m] take the fast swing
+        options: ``time_law`` and ``path`` "joint", ``ramp_fraction`` 0.1;
+        the others keep the settings above. 0 (default): off. The fast
+        options shorten flat swings most (flat 0.8 m: 7.23 → 9.25 cm/s,
+        swings 0.27 → 0.20 s) and lose runs on rough boards.
     """
 
     lift_height: float = 0.03
@@ -565,9 +572,10 @@ class SwingConfig:
     ramp_fraction: float = 0.2
     path: str = "cartesian"
     lift_off_reach: bool = False
+    fast_swing_relief: float = 0.0
 
     def __post_init__(self) -> None:
-        _check_nonnegative(self, ("lift_height", "clearance"), "swing")
+        _check_nonnegative(self, ("lift_height", "clearance", "fast_swing_relief"), "swing")
         if self.path not in ("cartesian", "joint"):
             raise ConfigError(f"swing.path must be 'cartesian' or 'joint', got {self.path!r}")
         if not (math.isfinite(self.lift_fraction) and 0 <= self.lift_fraction < 0.5):
