@@ -146,3 +146,28 @@ def test_joint_path_needs_the_legs_kinematics() -> None:
     assert len(spline.waypoints) == 4
     with pytest.raises(ConfigError):
         SwingConfig(path="straight")
+
+
+def test_fast_swing_relief_takes_the_fast_options_only_over_level_ground(littledog) -> None:
+    """Flat ground: the joint law and path, the shorter swing; over rocks: the settings as set."""
+    _, wb = littledog
+    gated = SwingConfig(fast_swing_relief=0.01)
+    flat = load_terrain("flat")
+    spline, angles = _swing(littledog, gated, 0, 0.5, 0.09, flat)
+    plain, _ = _swing(littledog, SwingConfig(), 0, 0.5, 0.09, flat)
+    fast, _ = _swing(littledog, SwingConfig(path="joint", **FAST), 0, 0.5, 0.09, flat)
+    assert len(spline.waypoints) == len(fast.waypoints) == 17
+    least = spline.least_time(angles, wb.velocity_limit[0])
+    assert least == pytest.approx(fast.least_time(angles, wb.velocity_limit[0]))
+    assert least < 0.9 * plain.least_time(angles, wb.velocity_limit[0])
+    rocks = load_terrain(ROCKS)
+    kept = 0
+    for x in (0.30, 0.45, 0.60, 0.75):
+        for leg in range(4):
+            spline, angles = _swing(littledog, gated, leg, x, 0.09, rocks)
+            plain, _ = _swing(littledog, SwingConfig(), leg, x, 0.09, rocks)
+            if len(spline.waypoints) == 4:
+                kept += 1
+                limit = wb.velocity_limit[leg]
+                assert spline.least_time(angles, limit) == plain.least_time(angles, limit)
+    assert kept >= 8

@@ -291,6 +291,18 @@ def build_initial_trajectory(
     if fixed is not None:
         values_arr[2:, :4] = fixed[2:]
         spline = BodySpline(np.array(knots), values_arr)
+    if swing_config.lift_off_reach:
+        # The same at lift-off for the foot about to lift: the preview leads
+        # the trunk ahead of the swing pose, which a trailing foot at the
+        # back of its reach then misses (a long stride's last crawl step).
+        pose = spline.value(times)
+        lift_xy = run.com[lift_off] - pose[lift_off, 4:6]
+        lifted = _reach_by_height_and_tilt(
+            wb, step.stance_before, np.concatenate([lift_xy, pose[lift_off, :4]])
+        )
+        if lifted is not None:
+            values_arr[1, :4] = lifted[2:]
+            spline = BodySpline(np.array(knots), values_arr)
     pose, pose_rate, pose_acc = spline.evaluate(times)
     offset = pose[:, 4:7]
 

@@ -332,6 +332,32 @@ def _interior_slopes(
     return v
 
 
+# The ramps of the fast swing options (``time_law`` and ``path`` "joint").
+FAST_RAMP_FRACTION = 0.1
+
+
+def _path_corridor(
+    s: NDArray[np.float64], t: NDArray[np.float64], foot_radius: float
+) -> NDArray[np.float64]:
+    """(N, 2) points [m] under the straight path from ``s`` to ``t``, a foot radius either side."""
+    stride = float(np.linalg.norm(t[:2] - s[:2]))
+    n = max(8, int(np.ceil(stride / 0.005)) + 1)
+    along = np.linspace(0.0, 1.0, n)[:, None] * (t[:2] - s[:2]) + s[:2]
+    if stride > 1e-9:
+        side = np.array([-(t[1] - s[1]), t[0] - s[0]]) / stride
+    else:
+        side = np.array([0.0, 1.0])
+    return np.concatenate([along + k * foot_radius * side for k in (-1.0, 0.0, 1.0)])
+
+
+def _ground_relief(
+    s: NDArray[np.float64], t: NDArray[np.float64], terrain: Terrain, foot_radius: float
+) -> float:
+    """Highest minus lowest ground [m] under the foot's straight path (:func:`_path_corridor`)."""
+    ground = np.asarray(terrain.height(_path_corridor(s, t, foot_radius)), dtype=float)
+    return float(np.max(ground) - np.min(ground))
+
+
 class SwingSpline:
     """A C² foot path through start, lift-off, drop-off and target, at rest at both ends.
 
@@ -493,6 +519,13 @@ class SwingSpline:
         """
         s = np.asarray(start, dtype=float)
         t = np.asarray(target, dtype=float)
+        if config.fast_swing_relief > 0 and terrain is not None:
+            relief = _ground_relief(s, t, terrain, foot_radius)
+            if relief <= config.fast_swing_relief:
+                config = replace(
+                    config, time_law="joint", path="joint", ramp_fraction=FAST_RAMP_FRACTION
+                )
+            config = replace(config, fast_swing_relief=0.0)
         if (
             config.path == "joint"
             and config.time_law == "joint"
@@ -529,15 +562,7 @@ class SwingSpline:
             return min((shaped, heuristic), key=lambda c: c.least_time(leg_angles, limit))
         top = max(s[2], t[2]) + config.lift_height
         if config.scan_terrain and terrain is not None:
-            stride = float(np.linalg.norm(t[:2] - s[:2]))
-            n = max(8, int(np.ceil(stride / 0.005)) + 1)
-            along = np.linspace(0.0, 1.0, n)[:, None] * (t[:2] - s[:2]) + s[:2]
-            if stride > 1e-9:
-                side = np.array([-(t[1] - s[1]), t[0] - s[0]]) / stride
-            else:
-                side = np.array([0.0, 1.0])
-            xy = np.concatenate([along + k * foot_radius * side for k in (-1.0, 0.0, 1.0)])
-            ground = float(np.max(terrain.height(xy)))
+            ground = float(np.max(terrain.height(_path_corridor(s, t, foot_radius))))
             top = max(top, ground + foot_radius + config.clearance)
         f = config.lift_fraction
         lift = s + f * (t - s)
