@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from roughwalk.terrain import load_terrain
@@ -39,3 +41,15 @@ def pallet_edge_climb(
     pos[node : node + 2, 0] = 1.01
     parts[motion.name] = motion.pack(pos, vel)
     return nlp, parts, task
+
+
+def central_differences(
+    f: Callable[[np.ndarray], np.ndarray], x: np.ndarray, columns: np.ndarray, h: float = 1e-6
+) -> np.ndarray:
+    """Central differences of ``f`` at ``x`` along ``columns``: one column per variable."""
+    out = []
+    for j in columns:
+        e = np.zeros_like(x)
+        e[j] = h
+        out.append((f(x + e) - f(x - e)) / (2 * h))
+    return np.array(out).T

@@ -5,7 +5,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 import pytest
-from _trajopt_problems import pallet_edge_climb
+from _trajopt_problems import central_differences, pallet_edge_climb
 from scipy.integrate import quad
 
 from roughwalk.robots import load_robot
@@ -152,15 +152,6 @@ def test_swing_height_and_step_edge_costs(problem) -> None:  # type: ignore[no-u
     assert value["swing_height"] == pytest.approx(nlp.config.costs.swing_height * swing)
 
 
-def _central(f, x: np.ndarray, columns: np.ndarray, h: float = 1e-6) -> np.ndarray:  # type: ignore[no-untyped-def]
-    out = []
-    for j in columns:
-        e = np.zeros_like(x)
-        e[j] = h
-        out.append((f(x + e) - f(x - e)) / (2 * h))
-    return np.array(out).T
-
-
 def test_block_jacobian_and_gradient_against_finite_differences(problem) -> None:  # type: ignore[no-untyped-def]
     # The Jacobian is assembled by hand from row blocks and the terrain's chain rule.
     nlp, x, p = problem
@@ -177,12 +168,15 @@ def test_block_jacobian_and_gradient_against_finite_differences(problem) -> None
 
     _, jac = nlp.jac_g(x, p)
     jac = np.asarray(ca.densify(jac))
-    fd = _central(g, x, columns)
+    fd = central_differences(g, x, columns)
     scale = np.maximum(1.0, np.abs(fd))
     assert np.max(np.abs(jac[:, columns] - fd) / scale) < 1e-5
     _, grad = nlp.grad_f(x, p)
     np.testing.assert_allclose(
-        np.asarray(grad).ravel()[columns], _central(f, x, columns)[0], rtol=1e-5, atol=1e-6
+        np.asarray(grad).ravel()[columns],
+        central_differences(f, x, columns)[0],
+        rtol=1e-5,
+        atol=1e-6,
     )
 
 
@@ -200,7 +194,7 @@ def test_block_hessian_against_finite_differences_of_the_gradient(problem) -> No
     hess = np.asarray(ca.densify(nlp.hess_lag(x, p, lam_f, lam_g)))
     hess = np.triu(hess) + np.triu(hess, 1).T
     columns = rng.choice(x.size, 25, replace=False)
-    fd = _central(lagrangian_gradient, x, columns, h=1e-5)
+    fd = central_differences(lagrangian_gradient, x, columns, h=1e-5)
     scale = np.maximum(1.0, np.abs(fd))
     assert np.max(np.abs(hess[:, columns] - fd) / scale) < 1e-4
 

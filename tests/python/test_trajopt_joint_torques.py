@@ -7,6 +7,7 @@ from dataclasses import replace
 import casadi as ca
 import numpy as np
 import pytest
+from _trajopt_problems import central_differences
 
 from roughwalk.robots import Robot, load_robot
 from roughwalk.terrain import load_terrain
@@ -126,15 +127,6 @@ def test_margin_scales_the_bounds(anymal: Robot) -> None:
     assert np.all(nlp.lbg[rows] == pytest.approx(-72.0))
 
 
-def _central(f, x: np.ndarray, columns: np.ndarray, h: float = 1e-6) -> np.ndarray:  # type: ignore[no-untyped-def]
-    out = []
-    for j in columns:
-        e = np.zeros_like(x)
-        e[j] = h
-        out.append((f(x + e) - f(x - e)) / (2 * h))
-    return np.array(out).T
-
-
 def test_jacobian_and_hessian_against_finite_differences(anymal: Robot) -> None:
     """At a perturbed heuristic guess: ∂τ/∂x, and ∇²(λᵀg) through the rows' chain rule."""
     nlp = _formulation(anymal, {})
@@ -151,7 +143,7 @@ def test_jacobian_and_hessian_against_finite_differences(anymal: Robot) -> None:
     def g(v: np.ndarray) -> np.ndarray:
         return _torque_rows(nlp, v, p)
 
-    fd = _central(g, x, columns)
+    fd = central_differences(g, x, columns)
     scale = np.maximum(1.0, np.abs(fd))
     assert np.max(np.abs(jac[:, columns] - fd) / scale) < 1e-5
 
@@ -164,7 +156,7 @@ def test_jacobian_and_hessian_against_finite_differences(anymal: Robot) -> None:
 
     hess = np.asarray(ca.densify(nlp.hess_lag(x, p, 0.0, lam_g)))
     hess = np.triu(hess) + np.triu(hess, 1).T
-    fd_hess = _central(lagrangian_gradient, x, columns, h=1e-5)
+    fd_hess = central_differences(lagrangian_gradient, x, columns, h=1e-5)
     scale = np.maximum(1.0, np.abs(fd_hess))
     assert np.max(np.abs(hess[:, columns] - fd_hess) / scale) < 1e-4
     assert np.abs(hess[:, columns]).max() > 1.0  # curved rows: a Hessian worth checking
