@@ -96,8 +96,8 @@ def main(argv: list[str] | None = None) -> int:
         metavar="KEY=VALUE",
         action="append",
         default=[],
-        help="override a simulation setting, or with a 'trajectory.' prefix a trajectory "
-        "setting (repeatable, dotted keys)",
+        help="override a simulation setting, with a 'trajectory.' prefix a trajectory "
+        "setting, with a 'footstep.' prefix a footstep planner setting (repeatable, dotted keys)",
     )
     args = ap.parse_args(argv)
     try:

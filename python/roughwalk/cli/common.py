@@ -97,12 +97,18 @@ def simulation_settings(items: list[str]) -> tuple[dict[str, str], dict[str, str
     """``--set KEY=VALUE`` items as (simulation, trajectory) settings, both checked.
 
     Keys prefixed ``trajectory.`` go, without the prefix, to
-    :func:`roughwalk.trajectories.trajectory_config`; the others to
+    :func:`roughwalk.trajectories.trajectory_config`; keys prefixed
+    ``footstep.`` stay among the simulation settings, for
+    :func:`roughwalk.sim.run` to give the footstep planner; the others go to
     :func:`roughwalk.sim.sim_config`. A malformed item or an unknown key or
     value raises :class:`~roughwalk.errors.ConfigError` before any run.
     """
+    from roughwalk.config import override
     from roughwalk.errors import ConfigError
+    from roughwalk.planning.footstep_config import FootstepConfig
+    from roughwalk.robots import load_robot
     from roughwalk.sim import sim_config
+    from roughwalk.sim.stride_reach import split_footstep_settings
     from roughwalk.trajectories import trajectory_config
 
     sim: dict[str, str] = {}
@@ -116,6 +122,10 @@ def simulation_settings(items: list[str]) -> tuple[dict[str, str], dict[str, str
             trajectory[key.removeprefix("trajectory.")] = value.strip()
         else:
             sim[key] = value.strip()
-    sim_config(None, **sim)
+    own, footstep = split_footstep_settings(sim)
+    sim_config(None, **own)
+    if footstep:
+        # Field names and value types are the same for every robot's planner.
+        override(FootstepConfig.for_robot(load_robot("littledog")), footstep)
     trajectory_config(None, **trajectory)
     return sim, trajectory

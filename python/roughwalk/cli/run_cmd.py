@@ -92,11 +92,15 @@ def register(sub: Any) -> None:
 
 def cmd_run(args: argparse.Namespace) -> int:
     """Run, print a summary, write the outputs; exit code 0 on success, 3 on a failed run."""
-    from roughwalk.config import configure
+    from roughwalk.config import configure, parse_set
     from roughwalk.sim import SimConfig, parse_disturbance, run
+    from roughwalk.sim.stride_reach import FOOTSTEP_PREFIX
     from roughwalk.viz.run_outputs import save_run_outputs
 
-    cfg = configure(SimConfig(), args.config, args.set)
+    # --set footstep.NAME=VALUE changes the footstep planner's config (run() checks it).
+    planner_sets = [s for s in args.set if s.strip().startswith(FOOTSTEP_PREFIX)]
+    cfg = configure(SimConfig(), args.config, [s for s in args.set if s not in planner_sets])
+    footstep = parse_set(planner_sets)
     start = parse_numbers(args.start, (2, 3), "--start")
     goal = parse_numbers(args.goal, (2,), "--goal")
     disturbances = [parse_disturbance(s) for s in args.disturb]
@@ -112,6 +116,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             config=cfg,
             disturbances=disturbances,
             progress=bar,
+            **footstep,
         )
     finally:
         bar.close()

@@ -17,7 +17,7 @@ from roughwalk.sim.executor import Executor, ProgressCallback
 from roughwalk.sim.footstep_source import CrawlSource, FootstepSource, default_source
 from roughwalk.sim.outcome import Outcome
 from roughwalk.sim.run_log import RunLog
-from roughwalk.sim.stride_reach import longer_step_config
+from roughwalk.sim.stride_reach import planner_config, split_footstep_settings
 
 __all__ = ["run", "RunResult", "sim_config"]
 
@@ -132,7 +132,8 @@ def run(
         "planner", "crawl", or a :class:`~roughwalk.sim.footstep_source.FootstepSource`.
     config:
         Simulation settings; ``overrides`` change fields by dotted key
-        (``**{"reflex.enabled": False}``).
+        (``**{"reflex.enabled": False}``), and keys prefixed ``footstep.``
+        the footstep planner's (``**{"footstep.edge_drop": 0.03}``).
     trajectory_config:
         Settings of trajectory generation (:class:`~roughwalk.trajectories.TrajectoryConfig`).
     disturbances:
@@ -148,6 +149,7 @@ def run(
     from roughwalk.robots import load_robot
     from roughwalk.terrain import load_terrain
 
+    overrides, footstep = split_footstep_settings(overrides)
     cfg = sim_config(config, **overrides)
     robot_obj = load_robot(robot) if isinstance(robot, str | Path) else robot
     terrain_obj = load_terrain(terrain) if isinstance(terrain, str | Path) else terrain
@@ -158,8 +160,8 @@ def run(
         seen = d.planner_terrain(seen)
     budget = cfg.executor.plan_expansions or None
     options: dict[str, Any] = {"expansions": budget, "start_snap_m": cfg.executor.start_snap_m}
-    if cfg.executor.longest_step > 0:
-        options["config"] = longer_step_config(robot_obj, cfg.executor.longest_step)
+    if cfg.executor.longest_step > 0 or footstep:
+        options["config"] = planner_config(robot_obj, cfg.executor.longest_step, footstep)
     if isinstance(planner, str):
         if planner == "auto":
             source: FootstepSource = default_source(robot_obj, seen, **options)
