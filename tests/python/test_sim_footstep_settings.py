@@ -87,3 +87,14 @@ def test_roughwalk_run_refuses_an_unknown_footstep_setting_naming_it(
     err = capsys.readouterr().err
     assert "edge_dorp" in err and "FootstepConfig" in err
     assert not (tmp_path / "index.html").exists()
+
+
+def test_roughwalk_run_takes_trajectory_settings_and_checks_them(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["run", "--robot", "littledog", "--terrain", "flat", "--start", "0.3,0,0"]
+    argv += ["--goal", "0.6,0", "--out-dir", str(tmp_path), "--no-video"]
+    assert main([*argv, "--set", "trajectory.swing.time_lwa=joint"]) == 1
+    assert "time_lwa" in capsys.readouterr().err
+    out = tmp_path / "run.json"
+    assert main([*argv, "--set", "trajectory.swing.time_law=joint", "--json", str(out)]) == 0

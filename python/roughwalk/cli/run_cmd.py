@@ -7,7 +7,13 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from roughwalk.cli.common import add_output_args, info, result_envelope, write_json
+from roughwalk.cli.common import (
+    add_output_args,
+    info,
+    result_envelope,
+    simulation_settings,
+    write_json,
+)
 
 __all__ = ["register", "cmd_run", "ProgressBar", "parse_numbers"]
 
@@ -92,15 +98,16 @@ def register(sub: Any) -> None:
 
 def cmd_run(args: argparse.Namespace) -> int:
     """Run, print a summary, write the outputs; exit code 0 on success, 3 on a failed run."""
-    from roughwalk.config import configure, parse_set
+    from roughwalk.config import configure
     from roughwalk.sim import SimConfig, parse_disturbance, run
-    from roughwalk.sim.stride_reach import FOOTSTEP_PREFIX
+    from roughwalk.trajectories import trajectory_config
     from roughwalk.viz.run_outputs import save_run_outputs
 
-    # --set footstep.NAME=VALUE changes the footstep planner's config (run() checks it).
-    planner_sets = [s for s in args.set if s.strip().startswith(FOOTSTEP_PREFIX)]
-    cfg = configure(SimConfig(), args.config, [s for s in args.set if s not in planner_sets])
-    footstep = parse_set(planner_sets)
+    # --set: simulation keys, and trajectory. / footstep. prefixed ones, all
+    # checked before the run (as the benches take them).
+    sim_sets, trajectory_sets = simulation_settings(args.set)
+    cfg = configure(SimConfig(), args.config)
+    trajectory = trajectory_config(None, **trajectory_sets) if trajectory_sets else None
     start = parse_numbers(args.start, (2, 3), "--start")
     goal = parse_numbers(args.goal, (2,), "--goal")
     disturbances = [parse_disturbance(s) for s in args.disturb]
@@ -114,9 +121,10 @@ def cmd_run(args: argparse.Namespace) -> int:
             goal,
             planner=args.planner,
             config=cfg,
+            trajectory_config=trajectory,
             disturbances=disturbances,
             progress=bar,
-            **footstep,
+            **sim_sets,
         )
     finally:
         bar.close()
