@@ -12,7 +12,7 @@ from roughwalk.errors import ConfigError
 from roughwalk.planning.footstep_config import FootstepConfig
 from roughwalk.robots import load_robot
 from roughwalk.sim import run
-from roughwalk.sim.stride_reach import planner_config, split_footstep_settings
+from roughwalk.sim.footstep_source import planner_config, split_footstep_settings
 
 
 def test_footstep_keys_are_split_from_the_simulation_settings() -> None:

@@ -108,7 +108,7 @@ def simulation_settings(items: list[str]) -> tuple[dict[str, str], dict[str, str
     from roughwalk.planning.footstep_config import FootstepConfig
     from roughwalk.robots import load_robot
     from roughwalk.sim import sim_config
-    from roughwalk.sim.stride_reach import split_footstep_settings
+    from roughwalk.sim.footstep_source import split_footstep_settings
     from roughwalk.trajectories import trajectory_config
 
     sim: dict[str, str] = {}

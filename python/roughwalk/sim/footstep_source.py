@@ -26,6 +26,7 @@ from roughwalk.errors import InvalidArgumentError
 from roughwalk.robots.canonical_frame import LEG_NAMES
 from roughwalk.sim.config import ExecutorConfig
 from roughwalk.sim.foothold_snap import snap_to_footholds
+from roughwalk.sim.stride_reach import longer_step_config
 from roughwalk.trajectories.body_keyframes import nominal_fit, pose_over_support
 from roughwalk.trajectories.whole_body import WholeBody
 
@@ -41,6 +42,9 @@ __all__ = [
     "PlannerSource",
     "default_source",
     "CRAWL_ORDER",
+    "FOOTSTEP_PREFIX",
+    "planner_config",
+    "split_footstep_settings",
 ]
 
 CRAWL_ORDER = ("LH", "LF", "RH", "RF")
@@ -332,3 +336,39 @@ def default_source(robot: Robot, terrain: Terrain, **options: Any) -> FootstepSo
         return PlannerSource(robot, terrain, **options)
     except ImportError:
         return CrawlSource(robot, terrain)
+
+
+FOOTSTEP_PREFIX = "footstep."
+"""Settings keys with this prefix go, without it, to the footstep planner's config."""
+
+
+def split_footstep_settings(
+    settings: dict[str, Any],
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(simulation, footstep planner) settings: keys prefixed ``footstep.`` go to the planner.
+
+    ``footstep.edge_drop=0.03`` or ``footstep.certificate.start_clearance=0.002``
+    become the :class:`~roughwalk.planning.footstep_config.FootstepConfig`
+    changes ``edge_drop`` and ``certificate.start_clearance``.
+    """
+    sim = {k: v for k, v in settings.items() if not k.startswith(FOOTSTEP_PREFIX)}
+    footstep = {
+        k.removeprefix(FOOTSTEP_PREFIX): v
+        for k, v in settings.items()
+        if k.startswith(FOOTSTEP_PREFIX)
+    }
+    return sim, footstep
+
+
+def planner_config(robot: Any, longest: float, footstep: dict[str, Any]) -> Any:
+    """The footstep planner's settings for ``robot``: longer actions, then ``footstep`` changes.
+
+    ``longest`` > 0 adds :func:`longer_step_config`'s actions; ``footstep``
+    holds dotted-key changes of the planner's config (applied last), checked
+    by :func:`roughwalk.config.override`, which names an unknown field.
+    """
+    from roughwalk.config import override
+    from roughwalk.planning.footstep_config import FootstepConfig
+
+    base = longer_step_config(robot, longest) if longest > 0 else FootstepConfig.for_robot(robot)
+    return override(base, footstep) if footstep else base

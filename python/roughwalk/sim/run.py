@@ -14,10 +14,15 @@ from roughwalk.errors import ConfigError, InvalidArgumentError
 from roughwalk.sim.config import SimConfig
 from roughwalk.sim.disturbances import Disturbance
 from roughwalk.sim.executor import Executor, ProgressCallback
-from roughwalk.sim.footstep_source import CrawlSource, FootstepSource, default_source
+from roughwalk.sim.footstep_source import (
+    CrawlSource,
+    FootstepSource,
+    default_source,
+    planner_config,
+    split_footstep_settings,
+)
 from roughwalk.sim.outcome import Outcome
 from roughwalk.sim.run_log import RunLog
-from roughwalk.sim.stride_reach import planner_config, split_footstep_settings
 
 __all__ = ["run", "RunResult", "sim_config"]
 
