@@ -43,7 +43,12 @@ forces run away between the nodes). With
 guess at margin 1, 15 of those 18 tasks converge (median 119 iterations,
 5.5 s of CPU; 2 iteration limits, 1 time-out at 700 iterations / 150 s),
 their plans ask 81–83 N·m at 100 Hz (the unconverged 90–93), and 17 of
-18 track (``roughwalk.track``; session 14's free optima 8 of 18).
+18 track (``roughwalk.track``; session 14's free optima 8 of 18). The
+other three (9, 11, 17) converge from their free optimum at the same
+clearance (``warm_start=``, 50–71 iterations, 2–7 s of CPU, 81–82 N·m) and
+track. The tracking bench's 5-iteration solves are the learned guess's
+(which asks 240–510 N·m): 24 of 30 tracked with these rows and clearance
+as without them.
 """
 
 from __future__ import annotations
