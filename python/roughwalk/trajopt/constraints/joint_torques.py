@@ -47,7 +47,7 @@ their plans ask 81–83 N·m at 100 Hz (the unconverged 90–93), and 17 of
 other three (9, 11, 17) converge from their free optimum at the same
 clearance (``warm_start=``, 50–71 iterations, 2–7 s of CPU, 81–82 N·m) and
 track. The tracking bench's 5-iteration solves are the learned guess's
-(which asks 240–510 N·m): 24 of 30 tracked with these rows and clearance
+(which asks 240–590 N·m): 24 of 30 tracked with these rows and clearance
 as without them.
 """
 
