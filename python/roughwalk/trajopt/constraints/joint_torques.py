@@ -20,15 +20,35 @@ margin is ``joint_torque_margin``. Measured (session 14, 16-step walk in
 5.5 s, learned initialiser): flat and single pallet converge in about as
 many iterations as without (single pallet 9–16 against 7–14, worst joint
 81–87 N·m at 100 Hz against 98–195), at twice the solve CPU (0.4–0.6 s).
-On the double pallet's 18 held-out tasks 0–29 that start at x > 0.057 m, no
-solve with the rows converged (warm-started from the free optimum where
-there is one, else from the learned guess; ≤ 700 iterations or 150 s: 13
-time-outs, 3 iteration limits, 2 locally infeasible; median 99 s CPU). From
-the free optimum of task 3, margin 4 converged in 81 iterations and margin 2
-did not in 225. Yet the unconverged plans, which ask 80–108 N·m where the
-free optima ask 261–592, executed better: 12 of 18 tracked against 8 of 18
-(6 gained, 2 lost; median tracking error 3.1 against 4.9 cm). Not the
-default: it needs a problem (or experience) in which it converges.
+
+On the double pallet they need ``swing_base_clearance`` 0.5. With the base
+0.7 × the nominal height above every foot, swing feet included, none of
+the 18 held-out tasks 0–29 that start at x > 0.057 m converged (session
+14: 13 time-outs, 3 iteration limits, 2 locally infeasible). Why (session
+15, task 3): while a front foot swings onto the top the CoM must stay 0.72
+m up and the hind legs, on the ground, stretch to their reach (at the free
+optimum 82 of the 392 stance samples have a leg beyond 97 % of a + b), and
+no plan near there asks much less: the soft form of these rows (their
+squared excess as a cost, weight 100) converges to a plan that still asks
+310 N·m, from the learned guess and from the free optimum alike. Given the
+hard rows, IPOPT's accepted steps move the force rates by 10³–10⁴ N/s (no
+cost curves them: the Lagrangian's Hessian there is ~10⁻⁹ against ~10⁸ for
+the feet) while the multipliers of the rows on the feet (terrain, base
+above feet, swing height, reach) grow to 10⁷ and the dual infeasibility to
+10¹². Rows written as shares of the limit (IPOPT's gradient scaling
+already divides them), a knee-bend row at every sample or rows at the
+force nodes only did not converge on task 3 either (the last lets the
+forces run away between the nodes). With
+``swing_base_clearance`` 0.5 (stance feet keep 0.7), from the learned
+guess at margin 1, 15 of those 18 tasks converge (median 119 iterations,
+5.5 s of CPU; 2 iteration limits, 1 time-out at 700 iterations / 150 s),
+their plans ask 81–83 N·m at 100 Hz (the unconverged 90–93), and 17 of
+18 track (``roughwalk.track``; session 14's free optima 8 of 18). The
+other three (9, 11, 17) converge from their free optimum at the same
+clearance (``warm_start=``, 50–71 iterations, 2–7 s of CPU, 81–82 N·m) and
+track. The tracking bench's 5-iteration solves are the learned guess's
+(which asks 240–590 N·m): 24 of 30 tracked with these rows and clearance
+as without them.
 """
 
 from __future__ import annotations
