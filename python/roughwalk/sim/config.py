@@ -485,7 +485,11 @@ class ReflexConfig:
         seeds 0–7 (``roughwalk bench littledog --classes large_rocks
         --expansions 40000 --seeds 8`` with the fast options and
         ``footstep.edge_drop=0.03``) 4/8 at 5.46 cm/s → 6/8 at 4.93 (seeds
-        4 and 5 rescued, at 4.79 and 2.93 cm/s; every other run the same).
+        4 and 5 rescued, at 4.79 and 2.93 cm/s; every other run the same);
+        held-out seeds 8–15 3/8 → 4/8 (seed 15 rescued at 3.83 cm/s; seeds
+        9–12 roll over in their first recovery either way); seeds 0–1 of
+        the other six classes the same runs but logs seed 1, which still
+        fails, two reflexes later.
     max_reflexes:
         Give up (a failed run) after this many reflexes.
     end_at_goal:
