@@ -100,3 +100,58 @@ def test_the_replan_event_gives_the_start_certificate_s_clearance(standing) -> N
     # A source that certifies nothing (the crawl) has none to give.
     _, _, crawl_event = replan(standing, from_trunk=True)
     assert crawl_event["start_clearance_m"] is None
+
+
+class OnlyANudgedStanceWithLHFirst:
+    """A crawl source certifying no stance but ``feet`` with one foot moved, and then only LH first.
+
+    Board AE (bench large rocks seed 4): the stance a slid LF left had no
+    start for RH, the leg due, and no footstep out of it for the others;
+    LF moved 1 cm with LH first had a plan.
+    """
+
+    name = "only-nudged-lh-first"
+
+    def __init__(self, robot: roughwalk.Robot, terrain: roughwalk.Terrain, feet: Any) -> None:
+        self.crawl = CrawlSource(robot, terrain)
+        self.feet = np.array(feet, dtype=float)
+        self.starts: list[PlanStart] = []
+
+    def plan(self, start: PlanStart, goal: NDArray[np.float64], time_limit: float) -> PlanAttempt:
+        self.starts.append(start)
+        assert start.feet is not None
+        if np.allclose(start.feet, self.feet):
+            return PlanAttempt(None, "invalid_input", "start stance has no pose certificate", 0.0)
+        if start.next_leg != LH:
+            return PlanAttempt(None, "infeasible", "the planner found no plan (infeasible)", 0.0)
+        return self.crawl.plan(start, goal, time_limit)
+
+
+def nudged_replan(standing: Any, any_leg: bool) -> tuple[bool, OnlyANudgedStanceWithLHFirst, Any]:
+    robot, terrain, measured = standing
+    source = OnlyANudgedStanceWithLHFirst(robot, terrain, measured.feet)
+    config = override(SimConfig(), {"reflex.replan_nudge_any_leg": any_leg})
+    executor = Executor(robot, terrain, source, config=config)
+    executor._reflex_next_leg = RH
+    holding = executor._standing(measured)
+    ok, _ = executor._replan(measured, holding, np.array([1.0, 0.0]), measured.time)
+    return ok, source, executor.log.events[-1]
+
+
+def test_a_nudged_stance_may_start_with_another_leg(standing) -> None:
+    """``reflex.replan_nudge_any_leg``: the first nudged stance, RH due, LH first."""
+    _, _, measured = standing
+    ok, source, event = nudged_replan(standing, any_leg=True)
+    assert ok and event["start"] == "nudged RH 1 cm, LH first"
+    nudged = [s for s in source.starts if not np.allclose(s.feet, measured.feet)]
+    # RH's own stances first (it lifts first, so its start matters least), then
+    # the legs in walking order after RH (RF has no plan either), up to LH.
+    assert [s.next_leg for s in nudged] == [RH, RF, LH]
+    assert all(np.allclose(s.feet, nudged[0].feet) for s in nudged)
+    moved = np.linalg.norm((nudged[0].feet - measured.feet)[:, :2], axis=1)
+    assert moved[RH] == pytest.approx(0.01) and np.all(np.delete(moved, RH) == 0)
+    # Off: only RH is tried first from each nudged stance, and the run ends there.
+    ok, source, event = nudged_replan(standing, any_leg=False)
+    assert not ok and event["start"] == "nudged RH 1 cm"
+    nudged = [s for s in source.starts if not np.allclose(s.feet, measured.feet)]
+    assert [s.next_leg for s in nudged] == [RH]

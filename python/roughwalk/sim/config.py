@@ -472,6 +472,24 @@ class ReflexConfig:
         are tried in walking order (a leg whose shin settled against a rock
         must step first: no stance keeping it there has a certificate).
         Only then the planned footholds and ``replan_nudge_m``.
+    replan_nudge_any_leg:
+        Each stance ``replan_nudge_m`` tries may start with any leg, the one
+        due to lift first and then the others in walking order, as the
+        measured stance may with ``replan_from_trunk``. Off: only the leg
+        due. Board AE (bench large rocks seed 4, ``--expansions 40000``,
+        the fast options and the rim check): LF slid 3.9 cm off a flank,
+        the recovery settled on four loaded feet, the stance was certified
+        for LF, RF or LH to lift but no footstep left it, and no stance
+        within 2 cm let RH (the leg due) lift; LF moved 1 cm left with LH
+        first has a plan. On by default since session 15: large rocks
+        seeds 0–7 (``roughwalk bench littledog --classes large_rocks
+        --expansions 40000 --seeds 8`` with the fast options and
+        ``footstep.edge_drop=0.03``) 4/8 at 5.46 cm/s → 6/8 at 4.93 (seeds
+        4 and 5 rescued, at 4.79 and 2.93 cm/s; every other run the same);
+        held-out seeds 8–15 3/8 → 4/8 (seed 15 rescued at 3.83 cm/s; seeds
+        9–12 roll over in their first recovery either way); seeds 0–1 of
+        the other six classes the same runs but logs seed 1, which still
+        fails, two reflexes later.
     max_reflexes:
         Give up (a failed run) after this many reflexes.
     end_at_goal:
@@ -503,6 +521,7 @@ class ReflexConfig:
     standing_bear: bool = True
     replan_nudge_m: float = 0.02
     replan_from_trunk: bool = True
+    replan_nudge_any_leg: bool = True
     max_reflexes: int = 6
     end_at_goal: bool = True
 

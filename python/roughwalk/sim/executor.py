@@ -626,15 +626,35 @@ class Executor:
             # first re-plan starts from RF moved 1 cm; its second finds no
             # stance within 5 cm, nor at the recovery's own footholds.)
             start_from = f"none within {100 * nudge:.0f} cm"
-            for feet in nudged_stances(measured.feet, nudge, start.next_leg):
-                start = PlanStart(feet=feet, next_leg=start.next_leg)
+            due = start.next_leg
+            # With replan_nudge_any_leg each nudged stance may start with any
+            # leg, as the measured one may (replan_from_trunk): the stance a
+            # slid foot leaves can be certified while the leg due to lift has
+            # no step out of it (board AE, bench large rocks seed 4).
+            firsts = (
+                [due, *later_legs(due)]
+                if self.config.reflex.replan_nudge_any_leg and due is not None
+                else [due]
+            )
+            candidates = (
+                (feet, first_leg)
+                for feet in nudged_stances(measured.feet, nudge, due)
+                for first_leg in firsts
+            )
+            for feet, first_leg in candidates:
+                start = PlanStart(feet=feet, next_leg=first_leg)
                 plan, tried, wall2 = self._make_plan(start, goal, budget)
                 wall += wall2
-                if plan is not None or "pose certificate" not in tried.reason:
+                # With one leg to try, a stance certified with no plan ends the search.
+                if plan is not None or (
+                    len(firsts) == 1 and "pose certificate" not in tried.reason
+                ):
                     attempt = tried
                     moved = np.linalg.norm((feet - measured.feet)[:, :2], axis=1)
                     leg = int(np.argmax(moved))
                     start_from = f"nudged {LEG_NAMES[leg]} {100 * moved[leg]:.0f} cm"
+                    if first_leg is not None and first_leg != due:
+                        start_from += f", {LEG_NAMES[first_leg]} first"
                     break
         first = None
         if plan is not None:
