@@ -308,7 +308,8 @@ class FootstepConfig:
         rocks 4/4 at 7.89 → 8.41 without a reflex, large rocks stay 3/4
         (5.77 → 6.15), gap, barrier and steps are unchanged; together they
         refuse 17 % of AC's footholds, 41 % of AD's, 38 % of AE's and 23 %
-        of Y's, 2–4 % of gap, barrier and steps. The contact
+        of Y's, 2–4 % of gap, barrier and steps. At 50° logs are 2/4 and
+        large rocks 3/4 at 4.52 cm/s. The contact
         normal's tilt instead (the gradient of the resting height, which
         bridges cracks) at 45° gave logs 2/4: the flanks' contact tilts
         (45–56°) lie nearer the cone than their slopes.
