@@ -7,6 +7,9 @@ down the rock and the robot fell within 1.7 s (``footstep.edge_drop``).
 With the rims refused, seed 1's plan put LF on a 52° flank, off which it
 slid (``footstep.max_foothold_slope``, opt-in: at 45° no start of that
 seed holds). The learned cost took both for footholds like their neighbours.
+On the logs board (AD) the rim check alone let feet onto log flanks of
+51–59° with less than 3 cm of drop beside them, off which they slid; the
+slope limit refuses them and keeps the logs' tops.
 """
 
 from __future__ import annotations
@@ -128,3 +131,46 @@ def test_the_52_degree_flank_large_rocks_seed_1_planned_lf_onto_is_refused(
     off = FootstepPlanner(littledog, board_ae, FootstepConfig.for_robot(littledog, edge_drop=0.03))
     assert np.isfinite(off.cost_front[i, j])
     assert np.isinf(on.cost_front[i, j])
+
+
+@pytest.fixture(scope="module")
+def board_ad(littledog_board: Callable[[str], Terrain]) -> Terrain:
+    return littledog_board("AD")
+
+
+def test_log_flanks_feet_slid_off_on_board_ad_pass_the_rim_check_and_the_slope_limit_refuses(
+    littledog: rw.Robot, board_ad: Terrain
+) -> None:
+    # Logs seeds 1 and 3 with the fast options and the rim check alone
+    # (bench_littledog.py --expansions 40000): the snapped start stance put
+    # RF (seed 1) and RH (seed 3) on a log's flank with less than 3 cm of
+    # drop beside them; RF slid 2 cm down it, RH 7 cm, and both runs fell.
+    # Each flank is steeper than the friction cone (μ = 1, 45°).
+    flanks = {"RF": (0.258, 0.226), "RH": (0.056, 0.272)}
+    # Footholds on the logs' tops on which the same runs' feet held.
+    tops = ((0.157, 0.408), (0.197, 0.272), (0.384, 0.272))
+    r = littledog.foot_radius
+    rim = edge_footholds(board_ad, r, drop=0.03)
+    steep = steep_footholds(board_ad, r, np.radians(45.0))
+    for x, y in flanks.values():
+        assert not rim[_cell(board_ad, x, y)], (x, y)
+        assert steep[_cell(board_ad, x, y)], (x, y)
+    for x, y in tops:
+        assert not rim[_cell(board_ad, x, y)] and not steep[_cell(board_ad, x, y)], (x, y)
+    rim_only = FootstepPlanner(
+        littledog, board_ad, FootstepConfig.for_robot(littledog, edge_drop=0.03)
+    )
+    both = FootstepPlanner(
+        littledog,
+        board_ad,
+        FootstepConfig.for_robot(littledog, edge_drop=0.03, max_foothold_slope=np.radians(45.0)),
+    )
+    for leg, (x, y) in flanks.items():
+        k = _cell(board_ad, x, y)
+        cost = "cost_front" if leg.endswith("F") else "cost_hind"
+        assert np.isfinite(getattr(rim_only, cost)[k])
+        assert np.isinf(getattr(both, cost)[k])
+    for x, y in tops:
+        k = _cell(board_ad, x, y)
+        assert both.cost_front[k] == rim_only.cost_front[k]
+        assert both.cost_hind[k] == rim_only.cost_hind[k]

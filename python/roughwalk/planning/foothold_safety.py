@@ -13,7 +13,10 @@ rocks runs fell from both kinds:
 - **on a slope** (seed 1 with the rims refused): the plan put LF on a 52°
   flank; it slid off as RF swung, and the robot rolled over. A foot
   pressed down vertically slides where the slope is steeper than the
-  friction cone, atan μ (45° at μ = 1).
+  friction cone, atan μ (45° at μ = 1). On the logs board (AD) the rim
+  check alone let the start put RF and RH on logs' flanks of 51–59° with
+  less than 3 cm of drop beside them; both slid (2 and 7 cm) and the runs
+  fell. A log's flank is a slope, not a rim: the slope limit refuses it.
 
 :func:`edge_footholds` marks the terrain cells where a foot of radius r
 would rest with terrain more than ``drop`` below its sole within r +

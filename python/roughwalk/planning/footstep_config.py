@@ -270,7 +270,12 @@ class FootstepConfig:
         r + margin is a slope of atan(d / (r + margin))); larger lets feet
         onto the rims of lower rocks. At 3 cm it refuses 16 % of the learned
         cost's footholds on the LittleDog board AE, 2 % on AC, 11 % on Y and
-        31 % on AD (the logs' flanks); at 4 cm none on Y, 26 % on AD. On AE (``bench_littledog.py
+        31 % on AD; at 4 cm none on Y, 26 % on AD. Most of AD's are the
+        cracks between touching logs (2–10 mm wide, down to the floor) and
+        the logs' ends. Counting no drop into a crack narrower than the
+        foot (a grey closing of the heights) refuses 18 % of AD, and logs
+        with the fast options then fall in all 4 seeds (1/4 with this
+        check, session 15). On AE (``bench_littledog.py
         --expansions 40000``, large rocks) the start put RF on a 7.5 cm
         rock's rim in seeds 2 and 3, which fell in the first swings;
         refused, and the foot moved onto the rock's top
@@ -294,7 +299,20 @@ class FootstepConfig:
         then finds no start in 18 (``--expansions 40000``); at 50° seed 1
         walks (4.98 cm/s; off, its plan put LF on a 52° flank, off which
         it slid), but seeds 0–5 still give 3 of 6 (1, 2, 3 against 2, 3,
-        4), after 4 reflexes against 1.
+        4), after 4 reflexes against 1. With ``edge_drop`` 3 cm alone, the
+        logs' (AD) starts put RF and RH on 51–59° flanks with less than
+        3 cm of drop beside them, off which they slid; at 45° with
+        ``edge_drop`` 3 cm and the fast options (session 15, 4 seeds)
+        26 of 28 runs against 24: logs go 1/4 → 3/4 (seed 1 at 2.9 cm/s
+        after 4 reflexes), round rocks 4/4 at 7.72 → 8.14 cm/s and sloped
+        rocks 4/4 at 7.89 → 8.41 without a reflex, large rocks stay 3/4
+        (5.77 → 6.15), gap, barrier and steps are unchanged; together they
+        refuse 17 % of AC's footholds, 41 % of AD's, 38 % of AE's and 23 %
+        of Y's, 2–4 % of gap, barrier and steps. At 50° logs are 2/4 and
+        large rocks 3/4 at 4.52 cm/s. The contact
+        normal's tilt instead (the gradient of the resting height, which
+        bridges cracks) at 45° gave logs 2/4: the flanks' contact tilts
+        (45–56°) lie nearer the cone than their slopes.
 
     """
 
