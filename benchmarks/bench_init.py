@@ -143,7 +143,8 @@ def _set_suffix(spec: ProblemSpec) -> str:
 
 def spec_of_models(env: str, models: list[tuple[str, LearnedModel]]) -> ProblemSpec:
     """The held-out problem: every initialiser solves the newest model's constraints and costs."""
-    spec = ProblemSpec("anymal_c", env, "walk", 16, 5.5)
+    space = task_space(env)
+    spec = ProblemSpec("anymal_c", space.terrain, "walk", space.steps, space.duration)
     if not models:
         return spec
     model = models[-1][1]
