@@ -91,3 +91,15 @@ def test_the_tracking_bench_finds_a_shipped_model_of_the_double_pallet_s_walk() 
     space = task_space("double_pallet")
     assert model.header["problem"]["steps"] == space.steps == 20
     assert model.header["problem"]["duration"] == space.duration
+
+
+def test_the_init_bench_takes_the_shipped_model_of_the_environment_s_walk() -> None:
+    # The 16-step double-pallet model stays shipped (roughwalk optimize's
+    # default walk); the bench must not hand its guesses to the 20-step NLP.
+    bench = load_benchmark("bench_init")
+    for env in ("double_pallet", "single_pallet"):
+        space = task_space(env)
+        models = bench._models(None, env)
+        assert len(models) == 1
+        problem = models[0][1].header["problem"]
+        assert (problem["steps"], problem["duration"]) == (space.steps, space.duration)
