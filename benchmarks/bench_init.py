@@ -78,14 +78,18 @@ TARGETS = {"median_solve_s": 0.25, "iteration_ratio": 4.0, "beyond_g_max": 0.01}
 
 
 def _models(folder: Path | None, env: str) -> list[tuple[str, LearnedModel]]:
-    """LearnedInit-k models: ``learned_init_K.npz`` in ``folder``, else the shipped one."""
+    """``learned_init_K.npz`` models in ``folder``, else the shipped one of ``env``'s walk."""
     if folder is not None:
         paths = sorted(folder.glob("learned_init_*.npz"))
         return [(f"LearnedInit-{p.stem.rsplit('_', 1)[1]}", LearnedModel.load(p)) for p in paths]
     out = []
+    space = task_space(env)
     for path in shipped_models():
         model = LearnedModel.load(path)
-        if model.header["problem"]["terrain"] == env:
+        problem = model.header["problem"]
+        walk = (problem["steps"], problem["duration"])
+        # The environment's walk only: the double pallet also ships a 16-step model.
+        if problem["terrain"] == space.terrain and walk == (space.steps, space.duration):
             k = model.header["training"]["learned_init_round"]
             out.append((f"LearnedInit-{k} (shipped)", model))
     return out
@@ -143,7 +147,8 @@ def _set_suffix(spec: ProblemSpec) -> str:
 
 def spec_of_models(env: str, models: list[tuple[str, LearnedModel]]) -> ProblemSpec:
     """The held-out problem: every initialiser solves the newest model's constraints and costs."""
-    spec = ProblemSpec("anymal_c", env, "walk", 16, 5.5)
+    space = task_space(env)
+    spec = ProblemSpec("anymal_c", space.terrain, "walk", space.steps, space.duration)
     if not models:
         return spec
     model = models[-1][1]

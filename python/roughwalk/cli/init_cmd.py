@@ -28,8 +28,14 @@ def _problem_args(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--robot", default="anymal_c", help="a registered robot")
     p.add_argument("--gait", default="walk", help="walk (default), trot, pace, bound, gallop")
-    p.add_argument("--steps", type=int, default=16, help="swings of all feet (default 16)")
-    p.add_argument("--duration", type=float, default=5.5, help="total duration [s] (default 5.5)")
+    p.add_argument(
+        "--steps", type=int, help="swings of all feet (default: the environment's, 16 elsewhere)"
+    )
+    p.add_argument(
+        "--duration",
+        type=float,
+        help="total duration [s] (default: the environment's, 5.5 elsewhere)",
+    )
     p.add_argument(
         "--optimize-durations", action="store_true", help="optimise the phase durations too"
     )
@@ -179,14 +185,14 @@ def cmd_generate(args: argparse.Namespace) -> int:
         args.robot,
         space.terrain,
         args.gait,
-        args.steps,
-        args.duration,
+        space.steps if args.steps is None else args.steps,
+        space.duration if args.duration is None else args.duration,
         args.optimize_durations,
         None if args.constraints is None else constraint_set(args.constraints),
         cost_weights(args.set),
         solver_settings(args.set),
     )
-    out = args.out or DEFAULT_ROOT / f"{space.name}_{args.gait}{args.steps}_{args.split}"
+    out = args.out or DEFAULT_ROOT / f"{space.name}_{args.gait}{spec.steps}_{args.split}"
     seeds = parse_nearest(args.init)
     jitter = _jitter(args.jitter, args.init != "heuristic" and seeds is None)
     model = None

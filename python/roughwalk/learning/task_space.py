@@ -6,6 +6,23 @@ and ±0.75 m laterally, with yaw in ±30°, and a fixed goal on top (Melon
 asking for more tasks later extends a run without changing the first ones,
 and the held-out "test" split is a separate random stream, never seen in
 training.
+
+The walk a space's tasks are solved with is chosen per environment, as
+Melon et al. choose the horizon (§V). Flat ground and the single pallet
+walk 16 steps in 5.5 s, the double pallet 20 steps in 6.875 s, at the same
+0.34 s a step.
+Melon et al. kept the single pallet's parameters for the double pallet, but
+walked "about the same" distance as on flat ground (up to 1.5 m). Our
+double-pallet starts, 0.5–1.5 m back from the lower step, lie 1.3–2.3 m
+from its goal on the upper one. Sixteen steps advance the base 2.30 m at
+the very most (a stance foot stays put, so the base moves at most the
+range-of-motion box's 0.31 m per stance), and no 16-step solve from farther
+than 1.74 m converged, from any start (session 13). Session 15 reached
+starts from converged neighbours' solutions: 20 steps in 5.5 s converged
+up to 1.92 m, in 6.875 s up to 2.10 m (x = −0.30; farther starts have no
+converged solve yet), 24 steps in 8.25 s no farther. A box
+0.5–1.5 m back from the upper step instead would put front feet on the
+lower pallet: 13 of the 30 held-out starts then have no level stance.
 """
 
 from __future__ import annotations
@@ -22,6 +39,7 @@ from roughwalk.trajopt import Task
 __all__ = ["TaskSpace", "task_space", "ENVIRONMENTS", "SPLITS"]
 
 SPLITS = ("train", "test")
+_STEPS, _DURATION = 16, 5.5  # the pallets' walk of Melon 2020, §V
 _SPLIT_STREAM = {"train": 0, "test": 1}
 
 
@@ -39,6 +57,14 @@ class TaskSpace:
         Corners (x [m], y [m], yaw [rad]) of the start box.
     goal:
         (x [m], y [m], yaw [rad]) of the goal.
+    steps, duration:
+        The walk its tasks are solved with: swings of all feet and the
+        horizon T [s] (Melon 2020, §V: the horizon is chosen per
+        environment). More steps reach farther starts (each stance advances
+        the base at most the range-of-motion box's length), at more
+        variables and CPU per solve; the time per step is what makes a walk
+        dynamic. Left out of :meth:`to_dict` at 16 and 5.5 s, so that runs
+        recorded before the fields existed still resume.
 
     """
 
@@ -47,12 +73,19 @@ class TaskSpace:
     start_low: tuple[float, float, float]
     start_high: tuple[float, float, float]
     goal: tuple[float, float, float]
+    steps: int = _STEPS
+    duration: float = _DURATION
 
     def __post_init__(self) -> None:
         if any(lo > hi for lo, hi in zip(self.start_low, self.start_high, strict=True)):
             raise ConfigError(
                 f"task space '{self.name}': start_low {self.start_low} exceeds "
                 f"start_high {self.start_high}"
+            )
+        if self.steps < 1 or not self.duration > 0:
+            raise ConfigError(
+                f"task space '{self.name}': steps must be ≥ 1 and duration > 0 s, got "
+                f"{self.steps} and {self.duration}"
             )
 
     def task(self, index: int, *, seed: int = 0, split: str = "train") -> Task:
@@ -70,8 +103,11 @@ class TaskSpace:
         return [self.task(i, seed=seed, split=split) for i in range(n)]
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data for JSON."""
-        return asdict(self)
+        """Plain data for JSON (``steps`` and ``duration`` only when not 16 and 5.5 s)."""
+        data = asdict(self)
+        if (self.steps, self.duration) == (_STEPS, _DURATION):
+            del data["steps"], data["duration"]
+        return data
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> TaskSpace:
@@ -83,6 +119,8 @@ class TaskSpace:
                 _triple(data["start_low"]),
                 _triple(data["start_high"]),
                 _triple(data["goal"]),
+                int(data.get("steps", _STEPS)),
+                float(data.get("duration", _DURATION)),
             )
         except KeyError as e:
             raise ConfigError(f"task space lacks the field {e}; got {sorted(data)}") from None
@@ -98,11 +136,14 @@ class TaskSpace:
         lateral: float = 0.75,
         yaw: float = math.radians(30.0),
         name: str | None = None,
+        steps: int = _STEPS,
+        duration: float = _DURATION,
     ) -> TaskSpace:
         """Melon's task space on any terrain: starts ``back`` [m] before ``edge_x``.
 
         Without ``edge_x`` the starts lie ``back`` before the goal's x. The
-        lateral offset [m] is around the goal's y, the yaw [rad] around 0.
+        lateral offset [m] is around the goal's y, the yaw [rad] around 0;
+        the tasks are walked in ``steps`` swings over ``duration`` [s].
         """
         edge = goal[0] if edge_x is None else edge_x
         return cls(
@@ -111,6 +152,8 @@ class TaskSpace:
             (edge - back[1], goal[1] - lateral, -yaw),
             (edge - back[0], goal[1] + lateral, yaw),
             goal,
+            steps,
+            duration,
         )
 
 
@@ -120,10 +163,13 @@ def _triple(value: Any) -> tuple[float, float, float]:
 
 
 # The pallets' near edge is at x = 1 m (terrain generators); flat ground's
-# goal is 1.5 m ahead of the middle of the same start box.
+# goal is 1.5 m ahead of the middle of the same start box. The double
+# pallet's walk: the module docstring.
 ENVIRONMENTS: dict[str, TaskSpace] = {
     "single_pallet": TaskSpace.for_terrain("single_pallet", (1.6, 0.0, 0.0), edge_x=1.0),
-    "double_pallet": TaskSpace.for_terrain("double_pallet", (1.8, 0.0, 0.0), edge_x=1.0),
+    "double_pallet": TaskSpace.for_terrain(
+        "double_pallet", (1.8, 0.0, 0.0), edge_x=1.0, steps=20, duration=6.875
+    ),
     "flat": TaskSpace.for_terrain("flat", (1.5, 0.0, 0.0), edge_x=1.0),
 }
 
