@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -12,7 +13,11 @@ from roughwalk.errors import ConfigError
 from roughwalk.planning.footstep_config import FootstepConfig
 from roughwalk.robots import load_robot
 from roughwalk.sim import run
-from roughwalk.sim.footstep_source import planner_config, split_footstep_settings
+from roughwalk.sim.footstep_source import (
+    EXECUTION_FOOTHOLD_SAFETY,
+    planner_config,
+    split_footstep_settings,
+)
 
 
 def test_footstep_keys_are_split_from_the_simulation_settings() -> None:
@@ -30,11 +35,15 @@ def test_footstep_keys_are_split_from_the_simulation_settings() -> None:
 def test_planner_config_applies_the_changes_after_the_longer_actions() -> None:
     robot = load_robot("littledog")
     default = FootstepConfig.for_robot(robot)
-    assert planner_config(robot, 0.0, {}) == default
+    # A walk refuses rims and flanks beyond the friction cone unless told otherwise.
+    walk = planner_config(robot, 0.0, {})
+    assert walk == replace(default, **EXECUTION_FOOTHOLD_SAFETY)
+    assert walk.edge_drop > 0 and walk.max_foothold_slope < default.max_foothold_slope
+    assert planner_config(robot, 0.0, {"edge_drop": "0"}).edge_drop == 0.0
     config = planner_config(
-        robot, 0.4, {"edge_drop": "0.03", "certificate.start_clearance": "0.002"}
+        robot, 0.4, {"edge_drop": "0.04", "certificate.start_clearance": "0.002"}
     )
-    assert config.edge_drop == pytest.approx(0.03)
+    assert config.edge_drop == pytest.approx(0.04)
     assert config.certificate.start_clearance == pytest.approx(0.002)
     # The longer actions are still there: the changes did not start from the defaults.
     assert max(a[0] for a in config.actions) > max(a[0] for a in default.actions) + 1e-6

@@ -206,6 +206,6 @@ def test_a_still_robot_on_three_loaded_feet_is_settled_only_when_three_are_asked
     # Turning faster than the rate: not settled, however many feet bear load.
     assert not settled(state([6.7] * 4, 0.3), 0.2, 3, 1.0)
     assert settled(state([6.7] * 4, 0.05), 0.2, 4, 1.0)
-    assert ReflexConfig().settled_loaded_feet == 4
+    assert ReflexConfig().settled_loaded_feet == 3
     with pytest.raises(roughwalk.ConfigError, match="settled_loaded_feet must be 3 or 4"):
         ReflexConfig(settled_loaded_feet=2)

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _even_swings import EVEN_SWINGS
 
 import roughwalk
 from roughwalk import _core
@@ -194,10 +195,16 @@ def test_an_early_reflex_catches_a_push_towards_a_swinging_front_foot(littledog)
     # trunk moving sideways at 0.22 m/s, and the robot rolled over on
     # its lowered left feet; gated at 0.03 rad one reflex rescues it (the
     # trunk still rolls 18°, past assert_walked_to_goal's 0.3 rad).
+    # Measured with the swings and strides of session 10 (pinned: the
+    # defaults since session 15 swing and step otherwise, and are checked
+    # under the same push at the end).
     terrain = roughwalk.load_terrain("flat")
     push = Push(impulse_ns=1.0, at_s=2.0, direction_deg=90.0)
-    config = roughwalk.trajectories.trajectory_config(**FAST_SWINGS)
-    result = walk(littledog, terrain, disturbances=[push], trajectory_config=config)
+    config = roughwalk.trajectories.trajectory_config(**{**EVEN_SWINGS, **FAST_SWINGS})
+    former = {"executor.longest_step": 0.0, "reflex.settled_loaded_feet": 4}
+    result = walk(
+        littledog, terrain, disturbances=[push], trajectory_config=config, overrides=former
+    )
     assert result.outcome.reflexes == 1 and result.outcome.replans == 1
     assert [e["detail"] for e in result.log.events if e["kind"] == "reflex"][0].startswith(
         "foot_force (RH)"
@@ -210,9 +217,12 @@ def test_an_early_reflex_catches_a_push_towards_a_swinging_front_foot(littledog)
         terrain,
         disturbances=[push],
         trajectory_config=config,
-        overrides={"reflex.foot_force_tilt_rad": 0.05},
+        overrides={**former, "reflex.foot_force_tilt_rad": 0.05},
     )
     assert late.outcome.fell
+    # The defaults: the same push, one reflex (RF's foot force), and the goal.
+    default = walk(littledog, terrain, disturbances=[push]).outcome
+    assert default.success and default.reflexes == 1 and not default.fell, default.reason
 
 
 class StopsInsideGoalRadius:
@@ -375,8 +385,9 @@ def test_plan_expansions_setting_makes_the_planner_stop_at_its_budget(littledog)
 
 @pytest.mark.skipif(not HAVE_PLANNER, reason="the compiled core predates the footstep planner")
 def test_longest_step_setting_lengthens_the_planned_strides(littledog) -> None:
-    # executor.longest_step (opt-in): forward actions of that many hip-to-hip
-    # lengths; a steady crawl's stride is 1.6 times the longest action.
+    # executor.longest_step (0.4 by default; 0: the planner's own actions):
+    # forward actions of that many hip-to-hip lengths; a steady crawl's
+    # stride is 1.6 times the longest action.
     terrain = roughwalk.load_terrain("flat")
 
     def planned(**extra: object) -> tuple[int, float]:
@@ -403,7 +414,7 @@ def test_longest_step_setting_lengthens_the_planned_strides(littledog) -> None:
             last[f.leg] = xy
         return plan.steps, float(np.median(strides))
 
-    steps, stride = planned()
+    steps, stride = planned(**{"executor.longest_step": 0.0})
     longer_steps, longer_stride = planned(**{"executor.longest_step": 0.375})
     assert stride == pytest.approx(1.6 * 0.3 * 0.202, abs=0.01)
     assert longer_stride > stride + 0.015

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from _even_swings import EVEN_SWINGS
 from _trajectory_plans import BARRIER, barrier_step_plan, low_swing_config, step_down_plan
 from scipy.spatial import cKDTree
 
@@ -235,7 +236,7 @@ def test_swing_timing_under_the_landing_trunk_shortens_a_step_down(littledog) ->
     )
 
     def generator(trunk: str) -> FootstepTrajectoryGenerator:
-        config = rw.trajectories.trajectory_config(**{"timing.swing_trunk": trunk})
+        config = rw.trajectories.trajectory_config(**{"timing.swing_trunk": trunk, **EVEN_SWINGS})
         return FootstepTrajectoryGenerator(littledog, terrain, sdf=sdf, config=config)
 
     # The nominal guesses (§5.2), before the measured timing

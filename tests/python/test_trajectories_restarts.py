@@ -13,6 +13,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from _even_swings import EVEN_SWINGS
 from _trajectory_plans import BARRIER, barrier_step_plan
 
 import roughwalk as rw
@@ -28,7 +29,8 @@ from roughwalk.trajectories.generator import RETIME_MARGIN, FootstepTrajectoryGe
 @pytest.fixture(scope="module")
 def crawl(littledog: rw.Robot):
     terrain = rw.load_terrain("flat:length=1.2,width=0.5")
-    gen = FootstepTrajectoryGenerator(littledog, terrain)
+    config = rw.trajectories.trajectory_config(**EVEN_SWINGS)
+    gen = FootstepTrajectoryGenerator(littledog, terrain, config=config)
     plan = straight_crawl_plan(littledog, terrain, (0.3, 0.0), steps=4, stride=0.07)
     return gen, gen.prepare(plan)
 

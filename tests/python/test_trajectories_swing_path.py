@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from _even_swings import EVEN_SWING_FIELDS
 
 import roughwalk as rw
 from roughwalk.errors import ConfigError
@@ -132,7 +133,8 @@ def test_joint_path_is_never_slower_than_the_heuristic(littledog) -> None:
 
 def test_joint_path_only_under_the_joint_time_law(littledog) -> None:
     """Under the "even" law (which it does not speed up) the heuristic path is kept."""
-    spline, _ = _swing(littledog, SwingConfig(path="joint"), 0)
+    even = {**EVEN_SWING_FIELDS, "path": "joint"}
+    spline, _ = _swing(littledog, SwingConfig(**even), 0)
     assert len(spline.waypoints) == 4
     spline, _ = _swing(littledog, SwingConfig(path="joint", **FAST), 0)
     assert len(spline.waypoints) == 17
@@ -151,10 +153,10 @@ def test_joint_path_needs_the_legs_kinematics() -> None:
 def test_fast_swing_relief_takes_the_fast_options_only_over_level_ground(littledog) -> None:
     """Flat ground: the joint law and path, the shorter swing; over rocks: the settings as set."""
     _, wb = littledog
-    gated = SwingConfig(fast_swing_relief=0.01)
+    gated = SwingConfig(fast_swing_relief=0.01, **EVEN_SWING_FIELDS)
     flat = load_terrain("flat")
     spline, angles = _swing(littledog, gated, 0, 0.5, 0.09, flat)
-    plain, _ = _swing(littledog, SwingConfig(), 0, 0.5, 0.09, flat)
+    plain, _ = _swing(littledog, SwingConfig(**EVEN_SWING_FIELDS), 0, 0.5, 0.09, flat)
     fast, _ = _swing(littledog, SwingConfig(path="joint", **FAST), 0, 0.5, 0.09, flat)
     assert len(spline.waypoints) == len(fast.waypoints) == 17
     least = spline.least_time(angles, wb.velocity_limit[0])
@@ -165,7 +167,7 @@ def test_fast_swing_relief_takes_the_fast_options_only_over_level_ground(littled
     for x in (0.30, 0.45, 0.60, 0.75):
         for leg in range(4):
             spline, angles = _swing(littledog, gated, leg, x, 0.09, rocks)
-            plain, _ = _swing(littledog, SwingConfig(), leg, x, 0.09, rocks)
+            plain, _ = _swing(littledog, SwingConfig(**EVEN_SWING_FIELDS), leg, x, 0.09, rocks)
             if len(spline.waypoints) == 4:
                 kept += 1
                 limit = wb.velocity_limit[leg]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from _even_swings import EVEN_SWINGS
 
 import roughwalk as rw
 from roughwalk.trajectories import straight_crawl_plan
@@ -21,7 +22,7 @@ def crawl() -> tuple[rw.Robot, rw.Terrain, object, dict]:
 
 def timings(crawl, trunk: str) -> list:
     robot, terrain, sdf, plan = crawl
-    config = rw.trajectories.trajectory_config(**{"timing.swing_trunk": trunk})
+    config = rw.trajectories.trajectory_config(**{"timing.swing_trunk": trunk, **EVEN_SWINGS})
     gen = FootstepTrajectoryGenerator(robot, terrain, sdf=sdf, config=config)
     return gen, gen.prepare(plan)
 

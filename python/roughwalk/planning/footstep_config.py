@@ -279,8 +279,11 @@ class FootstepConfig:
         --expansions 40000``, large rocks) the start put RF on a 7.5 cm
         rock's rim in seeds 2 and 3, which fell in the first swings;
         refused, and the foot moved onto the rock's top
-        (``executor.start_snap_m``), both walk without a reflex. Opt-in
-        (session 14, ``--expansions 40000``, seeds 0–5): sloped rocks 4/6
+        (``executor.start_snap_m``), both walk without a reflex. Off for a
+        plan alone; a walk in physics plans with 3 cm (and
+        ``max_foothold_slope`` 45°) unless told otherwise
+        (:data:`roughwalk.sim.footstep_source.EXECUTION_FOOTHOLD_SAFETY`,
+        session 15). Alone (session 14, ``--expansions 40000``, seeds 0–5): sloped rocks 4/6
         → 6/6 (mean 5.66 → 7.05 cm/s, no reflex), large rocks 3/6 → 3/6
         (seeds 2, 3, 4 against 0, 1, 4: new plans put LF on a 52° flank,
         seed 1, and let LF slip 4.3 cm, seed 0), and on the 2-seed board
@@ -294,8 +297,9 @@ class FootstepConfig:
         (:func:`~roughwalk.planning.foothold_safety.steep_footholds`): a foot
         pressed down vertically slides beyond the friction cone, atan μ
         (45° at μ = 1). π/2 turns the check off. Smaller keeps a margin to
-        the cone and refuses more of a rocky board. Off by default: at 45°
-        it refuses 37 % of board AE's footholds, and large rocks seed 1
+        the cone and refuses more of a rocky board. Off for a plan alone; 45°
+        in a walk in physics (with ``edge_drop`` 3 cm; figures below). Alone
+        at 45° it refuses 37 % of board AE's footholds, and large rocks seed 1
         then finds no start in 18 (``--expansions 40000``); at 50° seed 1
         walks (4.98 cm/s; off, its plan put LF on a 52° flank, off which
         it slid), but seeds 0–5 still give 3 of 6 (1, 2, 3 against 2, 3,

@@ -425,8 +425,9 @@ class ReflexConfig:
         sooner, from a stance a hair different, it met a second
         foot-force reflex). 1 N·s side-push sweeps (``roughwalk bench
         push_recovery --from 1.6 --to 3.2 --direction ±90``): 8/9 and 8/9,
-        the same push times, with 3 and 4. Not the default: with the
-        default gait one class is slower.
+        the same push times, with 3 and 4. 3 by default since session 15,
+        with the fast swing options (see
+        :class:`~roughwalk.trajectories.config.SwingConfig`'s ``path``).
     lower_s:
         Time [s] to put all four feet down and centre the trunk over them.
     capture_max_m:
@@ -514,7 +515,7 @@ class ReflexConfig:
     settle_s: float = 0.3
     settled_rate_rad_s: float = 0.2
     settle_max_s: float = 1.5
-    settled_loaded_feet: int = 4
+    settled_loaded_feet: int = 3
     lower_s: float = 0.5
     capture_max_m: float = 0.04
     replan_budget_s: float = 2.0
@@ -625,8 +626,11 @@ class ExecutorConfig:
         the feet farther per swing); ``footstep.max_foot_travel`` (0.6 L)
         grows with it up to 0.85 of the fore–aft span a foot reaches
         (:mod:`roughwalk.sim.stride_reach`; 0.159 m, so ~0.42 L on
-        LittleDog). Opt-in: longer strides lengthen the joint-speed-bound
-        swings more than in proportion (demo course, 0.3 → 0.42 L: stride
+        LittleDog). 0.4 by default since session 15, with the fast swing
+        options and ``swing.lift_off_reach`` (see
+        :class:`~roughwalk.trajectories.config.SwingConfig`'s ``path``); with
+        the former "even" swings longer strides lengthened the
+        joint-speed-bound swings more than in proportion (demo course, 0.3 → 0.42 L: stride
         9.4 → 11.5 cm, mean swing 0.36 → 0.50 s, 4.67 → 4.50 cm/s), and
         barrier seed 0 fell at 0.42 L (RF's foot-force reflex stepping
         onto the barrier, then a roll over the right feet in the re-plan's
@@ -643,7 +647,7 @@ class ExecutorConfig:
     compute_time_scale: float = 1.0
     initial_plan_s: float = 10.0
     plan_expansions: int = 0
-    longest_step: float = 0.0
+    longest_step: float = 0.4
     start_snap_m: float = 0.015
 
     def __post_init__(self) -> None:

@@ -165,8 +165,7 @@ def run(
         seen = d.planner_terrain(seen)
     budget = cfg.executor.plan_expansions or None
     options: dict[str, Any] = {"expansions": budget, "start_snap_m": cfg.executor.start_snap_m}
-    if cfg.executor.longest_step > 0 or footstep:
-        options["config"] = planner_config(robot_obj, cfg.executor.longest_step, footstep)
+    options["config"] = planner_config(robot_obj, cfg.executor.longest_step, footstep)
     if isinstance(planner, str):
         if planner == "auto":
             source: FootstepSource = default_source(robot_obj, seen, **options)

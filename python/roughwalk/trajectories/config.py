@@ -464,7 +464,7 @@ class SwingConfig:
         rounder ones keep that gentle, ~25 m/s² peak on a 10 cm stride in
         0.33 s against ~150 m/s² at 0.1, and need less joint speed).
     time_law:
-        ``"even"`` (default): the foot moves along its path at a steady speed
+        ``"even"``: the foot moves along its path at a steady speed
         (in the metric below) with smooth ramps at both ends, so its joints'
         peak speeds sit nearer their means and the velocity limits allow a
         shorter swing (§5.2's timing rule is then less pessimistic).
@@ -485,7 +485,7 @@ class SwingConfig:
         other side swings, the trunk rolls over the feet it is pushed
         towards), and the sweep's default 1.6–3.2 s window misses those of
         "knots" (9/9 both ways; "even" 9/9 and 7/9).
-        ``"joint"``: as ``"even"``, but the pace along the path is the swing
+        ``"joint"`` (default): as ``"even"``, but the pace along the path is the swing
         leg's own, the largest joint speed over its limit (the
         velocity-limited time-optimal law with the same end ramps), where the
         leg's inverse kinematics is given; else it is ``"even"``, and so
@@ -502,9 +502,10 @@ class SwingConfig:
     ramp_fraction:
         With ``"even"``: fraction of the swing at each end over which the foot
         speeds up from rest and slows down to rest (peak over mean speed
-        1 / (1 − ramp_fraction)). Shorter ramps accelerate harder.
+        1 / (1 − ramp_fraction)). Shorter ramps accelerate harder. 0.1 by
+        default since session 15 (0.2 before; see ``path``).
     path:
-        ``"cartesian"`` (default): the heuristic path above, its lift-off and
+        ``"cartesian"``: the heuristic path above, its lift-off and
         drop-off at one height over the whole stride. ``"joint"``: the path
         is shaped in the swing leg's joint space (for the ``"joint"`` time
         law): the hip (HFE) and knee (KFE) bend by six sine modes each on
@@ -534,10 +535,19 @@ class SwingConfig:
         "joint": barrier 5.77 → 6.19 cm/s, steps 6.45 → 7.33, round rocks
         4.66 → 4.88, sloped rocks 1/2 7.21 → 8.16, gap 5.97 → 6.49, logs
         4.27 → 5.64, large rocks 3.31 → 3.71; 13 of 14 runs with both; 1 N·s
-        side pushes at 1.6–3.2 s survived right / left 6 / 7 → 7 / 8 of 9. Not
-        the default: the ``"joint"`` law itself, against ``"even"`` with
-        the same settings, is slower on round rocks (5.76), logs (6.08) and
-        large rocks (3.80).
+        side pushes at 1.6–3.2 s survived right / left 6 / 7 → 7 / 8 of 9. The
+        ``"joint"`` law alone, against ``"even"`` with the same settings, is
+        slower on round rocks (5.76), logs (6.08) and large rocks (3.80); with
+        the rest of the fast options below it is faster everywhere.
+        The fast options together (``time_law`` and ``path`` "joint",
+        ``ramp_fraction`` 0.1, ``lift_off_reach``, ``executor.longest_step``
+        0.4, ``reflex.settled_loaded_feet`` 3, ``footstep.edge_drop`` 0.03 and
+        ``footstep.max_foothold_slope`` 45°) are the defaults since session 15:
+        board bench over 4 seeds of every class 26 of 28 runs, round rocks 8.14,
+        sloped rocks 8.41, barrier 8.37, steps 7.96, gap 7.14 cm/s (4/4 each),
+        logs 3/4, large rocks 3/4. The former defaults ("even", "cartesian",
+        ramps 0.2, 0.3 L steps): 14 of 14 runs over 2 seeds at 4.4–6.0 cm/s,
+        sloped rocks 4/6 and large rocks 3/6 over 6 seeds.
     lift_off_reach:
         Where the foot about to lift is out of the leg's reach under the
         trunk the preview controller planned for lift-off, lower and tilt
@@ -552,8 +562,8 @@ class SwingConfig:
         ``executor.longest_step`` 0.4 / 0.45: 7.40 → 9.02 / 6.59 → 9.18
         cm/s (stretch 2.5 → 0.5 s / 3.8 → 0.5 s); at the default 0.3 L
         9.25 either way (only a straight crawl's last step, or one with
-        10 cm strides and more, needs it). Off by default: longer strides
-        are opt-in.
+        10 cm strides and more, needs it). On by default, with
+        ``executor.longest_step`` 0.4 (see ``path``).
     fast_swing_relief:
         Swings whose ground, under the foot's straight path and a foot
         radius either side, varies by at most this [m] take the fast swing
@@ -566,18 +576,19 @@ class SwingConfig:
         them), gap 5.86 → 7.02 cm/s, barrier 5.83 → 6.76, steps 5.95 → 6.70;
         at 0.01 large rocks seed 0 rolls over. 1 N·s side pushes
         (``bench_push_recovery.py --from 1.6 --to 3.2``) at 0.005: left 8/9,
-        right 7/9 (8/9, 8/9 off), hence still off.
+        right 7/9 (8/9, 8/9 off), hence still off. With the defaults since
+        session 15 (the fast options everywhere) it changes nothing.
     """
 
     lift_height: float = 0.03
     clearance: float = 0.025
     scan_terrain: bool = True
     lift_fraction: float = 0.3
-    time_law: str = "even"
+    time_law: str = "joint"
     vertical_weight: float = 1.5
-    ramp_fraction: float = 0.2
-    path: str = "cartesian"
-    lift_off_reach: bool = False
+    ramp_fraction: float = 0.1
+    path: str = "joint"
+    lift_off_reach: bool = True
     fast_swing_relief: float = 0.0
 
     def __post_init__(self) -> None:
