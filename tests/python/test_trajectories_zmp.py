@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from roughwalk.errors import InvalidArgumentError
@@ -189,6 +189,12 @@ def test_shrunk_triangle_by_margin_alone_is_the_incentre_scaling(seed: int) -> N
 def test_shrunk_triangle_plans_the_least_load_on_every_foot(seed: int, share: float) -> None:
     rng = np.random.default_rng(seed)
     tri = rng.uniform(-0.1, 0.1, (3, 2))
+    edges = np.linalg.norm(tri[[1, 2, 0]] - tri[[2, 0, 1]], axis=1)
+    area = _area(tri)
+    # No support triangle is flatter than a foot: on one a few µm high
+    # (seed 3371: 8 µm) the static force solve's regularisation, not the
+    # geometry, sets the loads (shares 0.497 against 0.500).
+    assume(2 * area / edges.max() >= 0.002)
     inner = shrink_triangle(tri, 0.01, min_share=share)
     from roughwalk.trajectories.contact_forces import static_contact_forces
     from roughwalk.trajectories.support_polygon import convex_polygon, polygon_margin
@@ -204,8 +210,6 @@ def test_shrunk_triangle_plans_the_least_load_on_every_foot(seed: int, share: fl
     support = np.tile([True, True, True, False], (50, 1))
     mass, g = 2.0, 9.81
     loads = static_contact_forces(feet, support, zmp, np.zeros((50, 3)), mass, g)[:, :3, 2]
-    edges = np.linalg.norm(tri[[1, 2, 0]] - tri[[2, 0, 1]], axis=1)
-    area = _area(tri)
     least = np.maximum(0.01 * edges / (2 * area), share)
     if least.sum() < 1.0:
         # (static_contact_forces regularises its solve: loads to ~1e-5 N)
