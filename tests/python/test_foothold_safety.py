@@ -113,6 +113,8 @@ def test_the_bench_start_with_rf_on_a_rock_rim_of_board_ae_is_refused(
     refused = planner.plan(start, goal, time_limit=None, expansions=10)
     assert refused.status == "invalid_input"
     assert "foot RF" in (refused.reason or "") and "not on a foothold" in (refused.reason or "")
+    assert refused.start_off_foothold == "RF"
+    assert refused.to_json()["start_off_foothold"] == "RF"
     off = FootstepPlanner(littledog, board_ae, FootstepConfig.for_robot(littledog, edge_drop=0.0))
     assert off.plan(start, goal, time_limit=None, expansions=10).status != "invalid_input"
 

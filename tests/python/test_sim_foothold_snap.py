@@ -42,7 +42,7 @@ def test_a_foot_off_the_foothold_border_is_snapped_and_the_replan_starts(planner
     for x in xs:
         trial = stance_at(robot, x - hind_x, y0 + h * j)
         result = fp.replan(trial, "LF", goal=goal, time_limit=0.5)
-        if "not on a foothold" not in (result.reason or ""):
+        if result.start_off_foothold is None:
             border = x
             break
     else:
@@ -50,12 +50,14 @@ def test_a_foot_off_the_foothold_border_is_snapped_and_the_replan_starts(planner
     off = stance_at(robot, border - hind_x - 1.5 * h, y0 + h * j)
     refused = fp.replan(off, "LF", goal=goal, time_limit=0.5)
     assert "not on a foothold" in (refused.reason or "")
+    assert refused.start_off_foothold in ("LH", "RH")
     snapped, moved = snap_to_footholds(fp, terrain, off, radius=0.02)
     assert moved and set(moved) <= {2, 3}
     shift = np.linalg.norm((snapped - off)[:, :2], axis=1)
     assert np.all(shift <= 0.02 + 1e-12) and np.all(shift[[0, 1]] == 0.0)
     np.testing.assert_array_equal(snapped[:, 2], off[:, 2])
     accepted = fp.replan(snapped, "LF", goal=goal, time_limit=0.5)
+    assert accepted.start_off_foothold is None
     assert "not on a foothold" not in (accepted.reason or "")
     # Feet already on footholds stay exactly where they are; too far, they stay too.
     same, none = snap_to_footholds(fp, terrain, snapped, radius=0.02)

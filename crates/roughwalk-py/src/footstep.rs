@@ -146,6 +146,7 @@ fn result_dict<'py>(py: Python<'py>, r: &FootstepPlanResult) -> PyResult<Bound<'
     d.set_item("status", r.status.issue_status())?;
     d.set_item("search_status", r.status.to_string())?;
     d.set_item("message", r.message.clone())?;
+    d.set_item("start_off_foothold", r.start_off_foothold)?;
     let steps: Vec<(usize, f64, f64, f64)> = r
         .footsteps
         .iter()

@@ -129,6 +129,11 @@ class FootstepPlan:
         ``"infeasible"`` (the search space was exhausted) or ``"invalid_input"``.
     reason:
         Why the input was invalid (None otherwise).
+    start_off_foothold:
+        With ``"invalid_input"`` because a start foot stands on no foothold
+        (off the terrain, unknown, or of infinite cost on the planner's
+        lattice): that foot's leg (``"LF"``, ...). None otherwise. A caller
+        may move that foot onto a foothold and plan again.
     footsteps:
         The initial stance (LF, RF, LH, RH), then one footstep per step.
     certificates:
@@ -194,6 +199,7 @@ class FootstepPlan:
     terrain: str = ""
     start: tuple[float, ...] = ()
     goal: tuple[float, float] = (math.nan, math.nan)
+    start_off_foothold: str | None = None
 
     @property
     def solved(self) -> bool:
@@ -232,6 +238,7 @@ class FootstepPlan:
         return {
             "status": self.status,
             "reason": self.reason,
+            "start_off_foothold": self.start_off_foothold,
             "footsteps": [f.to_json() for f in self.footsteps],
             "certificates": [c.to_json() for c in self.certificates],
             "initial_pose": None if self.initial_pose is None else self.initial_pose.to_json(),

@@ -365,6 +365,9 @@ class FootstepPlanner:
             terrain=self.terrain.spec,
             start=start,
             goal=goal,
+            start_off_foothold=(
+                None if raw["start_off_foothold"] is None else LEGS[raw["start_off_foothold"]]
+            ),
         )
 
 

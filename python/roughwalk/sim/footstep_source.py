@@ -276,7 +276,7 @@ class PlannerSource:
             result = self.planner.plan(
                 start.pose, g, time_limit=time_limit, expansions=self.expansions
             )
-            if self.start_snap_m > 0 and "not on a foothold" in (result.reason or ""):
+            if self.start_snap_m > 0 and result.start_off_foothold is not None:
                 # Put down with a foot on no foothold (a rock's rim): that foot
                 # goes onto the nearest foothold, the walk starts from there.
                 feet = self._stance_at(start.pose)

@@ -452,25 +452,51 @@ impl FootstepModel {
 
     /// Whether every foot of `s` stands on a foothold and the stance passes
     /// the geometric checks.
-    pub fn stance_ok(&self, s: &FootstepState) -> Result<(), String> {
+    pub fn stance_ok(&self, s: &FootstepState) -> Result<(), StanceError> {
         for (leg, &cell) in s.feet.iter().enumerate() {
             if !self.map.cost(cell, leg).is_finite() {
                 let [x, y] = self.lattice().xy(cell);
-                return Err(format!(
-                    "foot {} at ({x:.3}, {y:.3}) m is not on a foothold (off the terrain, unknown, or infinite cost)",
-                    crate::kinematics::quadruped::LEG_NAMES[leg]
-                ));
+                return Err(StanceError::OffFoothold { leg, x, y });
             }
         }
         for leg in 0..4 {
             if !self.geometry_ok(s, leg, s.feet[leg]) {
-                return Err(
-                    "the feet are too close together or crossed (min_foot_separation, crossing_margin)"
-                        .into(),
-                );
+                return Err(StanceError::Geometry);
             }
         }
         Ok(())
+    }
+}
+
+/// Why a stance is not one the planner may stand in.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StanceError {
+    /// Foot `leg` (canonical index) stands at lattice point (`x`, `y`) [m],
+    /// which is off the terrain, unknown, or of infinite cost.
+    OffFoothold {
+        /// Canonical leg index (LF, RF, LH, RH).
+        leg: usize,
+        /// Lattice point x [m].
+        x: f64,
+        /// Lattice point y [m].
+        y: f64,
+    },
+    /// Feet closer than `min_foot_separation` or crossed (`crossing_margin`).
+    Geometry,
+}
+
+impl std::fmt::Display for StanceError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            StanceError::OffFoothold { leg, x, y } => write!(
+                f,
+                "foot {} at ({x:.3}, {y:.3}) m is not on a foothold (off the terrain, unknown, or infinite cost)",
+                crate::kinematics::quadruped::LEG_NAMES[leg]
+            ),
+            StanceError::Geometry => f.write_str(
+                "the feet are too close together or crossed (min_foot_separation, crossing_margin)",
+            ),
+        }
     }
 }
 

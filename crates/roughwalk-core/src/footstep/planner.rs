@@ -12,7 +12,8 @@ use crate::error::CoreResult;
 use crate::footstep::certificate::PoseCertificate;
 use crate::footstep::config::FootstepConfig;
 use crate::footstep::model::{
-    FootstepAction, FootstepModel, FootstepProblem, FootstepRobot, ModelCounters, TreeEdge,
+    FootstepAction, FootstepModel, FootstepProblem, FootstepRobot, ModelCounters, StanceError,
+    TreeEdge,
 };
 use crate::footstep::state::FootstepState;
 use crate::heightfield::HeightField;
@@ -79,6 +80,10 @@ pub struct FootstepPlanResult {
     pub status: SearchStatus,
     /// Why the input was invalid.
     pub message: Option<String>,
+    /// When the input was invalid because a start foot stands on no
+    /// foothold: that foot's canonical leg index (the caller may move it to
+    /// a foothold and plan again).
+    pub start_off_foothold: Option<usize>,
     /// The initial stance (four footsteps, canonical order), then one
     /// footstep per step in execution order; empty without a plan.
     pub footsteps: Vec<Footstep>,
@@ -114,6 +119,25 @@ pub struct FootstepPlanResult {
     pub elapsed_s: f64,
 }
 
+/// Why a plan's input was refused.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputError {
+    /// What is wrong, for a person.
+    pub message: String,
+    /// The canonical leg index of a start foot on no foothold, when that is
+    /// what is wrong.
+    pub start_off_foothold: Option<usize>,
+}
+
+impl From<String> for InputError {
+    fn from(message: String) -> Self {
+        Self {
+            message,
+            start_off_foothold: None,
+        }
+    }
+}
+
 /// A footstep planner for one robot on one terrain.
 #[derive(Debug, Clone)]
 pub struct FootstepPlanner {
@@ -141,13 +165,18 @@ impl FootstepPlanner {
     }
 
     /// The start state of `start` and its certificate, or why it is invalid.
-    pub fn start_state(&self, start: &Start) -> Result<(FootstepState, PoseCertificate), String> {
+    pub fn start_state(
+        &self,
+        start: &Start,
+    ) -> Result<(FootstepState, PoseCertificate), InputError> {
         let config = self.model.config();
         let lattice = self.model.lattice();
         let (feet, next, trunk) = match *start {
             Start::Pose { x, y, yaw } => {
                 if !(x.is_finite() && y.is_finite() && yaw.is_finite()) {
-                    return Err(format!("start ({x}, {y}, {yaw}) must be finite"));
+                    return Err(InputError::from(format!(
+                        "start ({x}, {y}, {yaw}) must be finite"
+                    )));
                 }
                 let (s, c) = yaw.sin_cos();
                 let feet = self
@@ -162,12 +191,14 @@ impl FootstepPlanner {
                 trunk,
             } => {
                 if !feet.iter().flatten().all(|v| v.is_finite()) {
-                    return Err(format!("start feet {feet:?} must be finite"));
+                    return Err(InputError::from(format!(
+                        "start feet {feet:?} must be finite"
+                    )));
                 }
                 let Some(next) = config.walking_order.iter().position(|&l| l == next_leg) else {
-                    return Err(format!(
+                    return Err(InputError::from(format!(
                         "next_leg {next_leg} is not a leg index; valid: 0..4 (LF, RF, LH, RH)"
-                    ));
+                    )));
                 };
                 if let Some(t) = trunk {
                     let finite =
@@ -175,7 +206,9 @@ impl FootstepPlanner {
                             .chain(t.r.iter().flatten())
                             .all(|v| v.is_finite());
                     if !finite {
-                        return Err(format!("start trunk pose {t:?} must be finite"));
+                        return Err(InputError::from(format!(
+                            "start trunk pose {t:?} must be finite"
+                        )));
                     }
                 }
                 (feet, next, trunk)
@@ -194,19 +227,23 @@ impl FootstepPlanner {
             feet: cells,
             next: next as u8,
         };
-        self.model
-            .stance_ok(&state)
-            .map_err(|m| format!("start: {m}"))?;
+        self.model.stance_ok(&state).map_err(|e| InputError {
+            message: format!("start: {e}"),
+            start_off_foothold: match e {
+                StanceError::OffFoothold { leg, .. } => Some(leg),
+                StanceError::Geometry => None,
+            },
+        })?;
         let certificate = match trunk {
             Some(pose) => self.model.certify_start(&state, pose),
             None => self.model.certify(&state),
         };
         match certificate {
             Ok(c) => Ok((state, c)),
-            Err(f) => Err(format!(
+            Err(f) => Err(InputError::from(format!(
                 "start stance has no pose certificate (feet in collision or out of reach): {}",
                 f.describe()
-            )),
+            ))),
         }
     }
 
@@ -243,10 +280,13 @@ impl FootstepPlanner {
         let started = Instant::now();
         self.model.take_counters();
         self.model.take_tree();
-        let checked = self.check_goal(goal).and_then(|()| self.start_state(start));
+        let checked = self
+            .check_goal(goal)
+            .map_err(InputError::from)
+            .and_then(|()| self.start_state(start));
         let (start_state, start_certificate) = match checked {
             Ok(s) => s,
-            Err(message) => return self.invalid(message, started),
+            Err(error) => return self.invalid(error, started),
         };
         let config = self.model.config();
         let ara = AraStarConfig {
@@ -277,11 +317,12 @@ impl FootstepPlanner {
         self.finish(result, start_certificate, started)
     }
 
-    fn invalid(&mut self, message: String, started: Instant) -> FootstepPlanResult {
+    fn invalid(&mut self, error: InputError, started: Instant) -> FootstepPlanResult {
         let config = self.model.config();
         FootstepPlanResult {
             status: SearchStatus::InvalidInput,
-            message: Some(message),
+            message: Some(error.message),
+            start_off_foothold: error.start_off_foothold,
             footsteps: Vec::new(),
             certificates: Vec::new(),
             start_certificate: None,
@@ -338,6 +379,7 @@ impl FootstepPlanner {
         FootstepPlanResult {
             status: result.status,
             message: result.message,
+            start_off_foothold: None,
             footsteps,
             certificates,
             start_certificate,
@@ -573,8 +615,42 @@ pub(crate) mod tests {
         for (start, goal, reason) in cases {
             let r = run(&mut p, start, goal, SearchKind::AraStar, Some(10));
             assert_eq!(r.status, SearchStatus::InvalidInput, "{start:?} {goal:?}");
+            assert_eq!(r.start_off_foothold, None, "{start:?} {goal:?}");
             let m = r.message.unwrap();
             assert!(m.contains(reason), "{m}");
         }
+    }
+
+    #[test]
+    fn footstep_start_foot_on_no_foothold_is_named_by_its_leg() {
+        // No foothold within 3 cm of RF's nominal spot for a start at x = 0.2
+        // (the nominal stance puts RF at (0.292, -0.06)).
+        let hole = |x: f64, y: f64| {
+            if (x - 0.292).hypot(y + 0.06) < 0.03 {
+                f64::INFINITY
+            } else {
+                1.0
+            }
+        };
+        let mut p = planner(0.8, |_, _| 0.0, hole, test_config());
+        let start = Start::Pose {
+            x: 0.2,
+            y: 0.0,
+            yaw: 0.0,
+        };
+        let r = run(&mut p, start, [0.6, 0.0], SearchKind::AraStar, Some(10));
+        assert_eq!(r.status, SearchStatus::InvalidInput);
+        assert_eq!(r.start_off_foothold, Some(1), "{:?}", r.message);
+        assert!(r.message.unwrap().contains("foot RF"));
+        // The same start beside the hole plans: the field is only set when
+        // a start foot is on no foothold.
+        let beside = Start::Pose {
+            x: 0.2,
+            y: 0.1,
+            yaw: 0.0,
+        };
+        let r = run(&mut p, beside, [0.6, 0.1], SearchKind::AraStar, Some(3000));
+        assert!(r.status.is_solved(), "{:?} {:?}", r.status, r.message);
+        assert_eq!(r.start_off_foothold, None);
     }
 }
