@@ -9,7 +9,9 @@ slid (``footstep.max_foothold_slope``, opt-in: at 45° no start of that
 seed holds). The learned cost took both for footholds like their neighbours.
 On the logs board (AD) the rim check alone let feet onto log flanks of
 51–59° with less than 3 cm of drop beside them, off which they slid; the
-slope limit refuses them and keeps the logs' tops.
+slope limit refuses them and keeps the logs' tops. On the gap course a
+walk's plan put RF on the trench floor 3 cm past the near wall, where its
+knee met the rim (``footstep.wall_reach``).
 """
 
 from __future__ import annotations
@@ -21,7 +23,13 @@ import pytest
 
 import roughwalk as rw
 from roughwalk.planning import FootstepConfig, FootstepPlanner
-from roughwalk.planning.foothold_safety import edge_footholds, resting_height, steep_footholds
+from roughwalk.planning.foothold_safety import (
+    edge_footholds,
+    resting_height,
+    steep_footholds,
+    wall_footholds,
+)
+from roughwalk.sim.footstep_source import planner_config
 from roughwalk.terrain import Terrain
 
 R = 0.0095  # LittleDog's foot radius [m]
@@ -176,3 +184,49 @@ def test_log_flanks_feet_slid_off_on_board_ad_pass_the_rim_check_and_the_slope_l
         k = _cell(board_ad, x, y)
         assert both.cost_front[k] == rim_only.cost_front[k]
         assert both.cost_hind[k] == rim_only.cost_hind[k]
+
+
+def _trench() -> Terrain:
+    """Flat floor at 0 with a trench 12 cm wide and 10 cm deep from x = 0.10 to 0.22."""
+    x = np.arange(0.0, 0.32, DX)
+    xx, _ = np.meshgrid(x, x, indexing="ij")
+    h = np.where((xx >= 0.10) & (xx < 0.22), -0.10, 0.0)
+    return Terrain(h, x0=0.0, y0=0.0, dx=DX, dy=DX, name="trench")
+
+
+def test_a_trench_floor_is_a_wall_foothold_where_the_knee_meets_the_rim() -> None:
+    t = _trench()
+    front = wall_footholds(t, R, reach=0.075, height=0.09, heading=0.0, end="front")
+    hind = wall_footholds(t, R, reach=0.075, height=0.09, heading=0.0, end="hind")
+    # 3 cm past the near wall: a front knee (behind the foot) meets its rim;
+    # a hind knee (ahead) has 9 cm of floor before the far wall.
+    assert front[_cell(t, 0.13, 0.16)] and not hind[_cell(t, 0.13, 0.16)]
+    # 8 cm past the near wall, 4 cm before the far one: the other way round.
+    assert not front[_cell(t, 0.18, 0.16)] and hind[_cell(t, 0.18, 0.16)]
+    # The pads, a wall lower than the height, and a reach of 0 refuse nothing.
+    for x in (0.05, 0.27):
+        assert not front[_cell(t, x, 0.16)] and not hind[_cell(t, x, 0.16)]
+    assert not wall_footholds(t, R, 0.075, 0.11, 0.0, "front").any()
+    assert not wall_footholds(t, R, 0.0, 0.09, 0.0, "front").any()
+    # Heading π: walking the other way, the far wall is behind the front feet.
+    back = wall_footholds(t, R, reach=0.075, height=0.09, heading=np.pi, end="front")
+    assert back[_cell(t, 0.18, 0.16)] and not back[_cell(t, 0.13, 0.16)]
+
+
+def test_the_wall_check_refuses_rf_the_gap_floor_beside_the_near_wall_and_keeps_a_way_across(
+    littledog: rw.Robot,
+) -> None:
+    # Gap seed 0 (bench_littledog.py --expansions 40000, session-15 defaults):
+    # step 20 put RF on the trench floor at x = 0.970, 3 cm past the near wall
+    # (x = 0.94); RF's shank came to rest on the rim, the foot hung 7 cm above
+    # the floor, LF and RH lost their load and the foot-force reflex fired.
+    gap = rw.load_terrain("gap")
+    walk = FootstepPlanner(littledog, gap, planner_config(littledog, 0.4, {"wall_reach": 0.075}))
+    unchecked = FootstepPlanner(littledog, gap, planner_config(littledog, 0.4, {}))
+    rf = _cell(gap, 0.970, -0.037)
+    assert np.isfinite(unchecked.cost_front[rf])
+    assert np.isinf(walk.cost_front[rf])
+    # The trench floor keeps footholds for both ends: front feet near its far
+    # wall, hind feet near its near one, where the plans' other feet stood.
+    assert np.isfinite(walk.cost_front[_cell(gap, 1.03, -0.04)])
+    assert np.isfinite(walk.cost_hind[_cell(gap, 0.975, -0.068)])

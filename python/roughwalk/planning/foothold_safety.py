@@ -1,4 +1,4 @@
-"""Footholds a round foot slides off: a rock's rim, and slopes beyond the friction cone.
+"""Footholds a round foot slides off (rims, slopes past the friction cone) or a knee hits a wall at.
 
 The learned terrain cost (Zucker 2011, §4.2) hardly tells such footholds
 from their neighbours: its quadratic fits over discs of 1–6 cm smooth a
@@ -25,6 +25,20 @@ onto the height field, max over the disc of h(p) + √(r² − |p − c|²) − 
 foot on the floor beside a wall rests on the floor and is not on an edge,
 one on top of the wall within r of its rim is. :func:`steep_footholds`
 marks the cells whose mean slope over the foot's disc exceeds a limit.
+
+:func:`wall_footholds` marks the cells with a wall beside them where the
+leg stands: LittleDog's knees point backwards on the front legs and forwards
+on the hind legs, 2–7 cm from the foot and 10–11 cm above its sole, so a
+front foot put down just past a wall (the near side of a trench) brings its
+shank onto the wall's rim. On the bench's gap (a 12 cm trench, 10 cm deep,
+``bench_littledog.py --expansions 40000``, seed 0) the plan put RF on the
+trench floor 3 cm past the near wall: its step's touchdown sample had the
+shank 1.6 cm inside the rim (the step was marked invalid and walked as it
+was), the shank came to rest on the rim, the foot hung 7 cm above the floor,
+LF and RH lost their load, and the foot-force reflex cost 1.1 s. The pose
+certificate had passed that stance: it checks the certified trunk pose,
+not the trunk of the swing's touchdown, which lags behind it and slants the
+leg further back.
 """
 
 from __future__ import annotations
@@ -35,7 +49,13 @@ from scipy import ndimage
 
 from roughwalk.terrain.terrain import Terrain
 
-__all__ = ["edge_footholds", "resting_height", "steep_footholds", "unsafe_footholds"]
+__all__ = [
+    "edge_footholds",
+    "resting_height",
+    "steep_footholds",
+    "unsafe_footholds",
+    "wall_footholds",
+]
 
 
 def _disc(radius: float, dx: float, dy: float) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
@@ -95,6 +115,41 @@ def steep_footholds(terrain: Terrain, foot_radius: float, max_slope: float) -> N
     mx = ndimage.convolve(gx, mean, mode="nearest")
     my = ndimage.convolve(gy, mean, mode="nearest")
     return np.asarray(np.hypot(mx, my) > np.tan(max_slope), dtype=bool)
+
+
+def wall_footholds(
+    terrain: Terrain,
+    foot_radius: float,
+    reach: float,
+    height: float,
+    heading: float,
+    end: str,
+) -> NDArray[np.bool_]:
+    """Cells (nx, ny) with a wall beside them, on the side where the leg's knee stands.
+
+    A cell is at a wall when, in the strip of the foot's width (2
+    ``foot_radius``) that runs ``reach`` [m] from its centre towards the knee
+    (backwards along ``heading`` [rad] for the ``end`` "front" legs, forwards
+    for "hind"), the terrain rises more than ``height`` [m] above the sole of
+    the foot resting there (:func:`resting_height`). ``reach`` ≤ 0 marks none.
+    """
+    shape = np.asarray(terrain.heights).shape
+    if reach <= 0:
+        return np.zeros(shape, dtype=bool)
+    if end not in ("front", "hind"):
+        raise ValueError(f"end must be 'front' or 'hind', got {end!r}")
+    sign = -1.0 if end == "front" else 1.0
+    ux, uy = sign * np.cos(heading), sign * np.sin(heading)
+    ni = max(int(np.ceil(reach / terrain.dx)), 0)
+    nj = max(int(np.ceil(reach / terrain.dy)), 0)
+    i, j = np.mgrid[-ni : ni + 1, -nj : nj + 1]
+    px, py = i * terrain.dx, j * terrain.dy
+    along = px * ux + py * uy
+    across = np.abs(-px * uy + py * ux)
+    strip = (along >= -1e-12) & (along <= reach + 1e-12) & (across <= foot_radius + 1e-12)
+    h = np.asarray(terrain.heights, dtype=float)
+    high = ndimage.maximum_filter(h, footprint=strip, mode="nearest")
+    return np.asarray(high - resting_height(terrain, foot_radius) > height, dtype=bool)
 
 
 def unsafe_footholds(

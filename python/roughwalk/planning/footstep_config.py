@@ -317,6 +317,37 @@ class FootstepConfig:
         normal's tilt instead (the gradient of the resting height, which
         bridges cracks) at 45° gave logs 2/4: the flanks' contact tilts
         (45–56°) lie nearer the cone than their slopes.
+    wall_reach:
+        A cell is no foothold for the front legs where the terrain rises more
+        than ``wall_height`` above the sole of a foot resting there within
+        this [m] behind it (along ``cost_heading``), nor for the hind legs
+        within this ahead of it: there the leg's knee, which points back on
+        the front legs and forwards on the hind ones, meets the wall's rim
+        (:func:`~roughwalk.planning.foothold_safety.wall_footholds`). 0
+        turns the check off. Larger keeps feet farther from walls (a trench
+        narrower than this leaves the front feet no foothold on its floor).
+        Off, in a walk too. 7.5 cm is the measured setting: in the gap runs
+        a front knee stood up to 6.5 cm behind its foot at touchdown (seed
+        1's LF, 6.5 cm past the trench's near wall, cleared the rim by 0.1 mm
+        in its trajectory), plus 1 cm; it refuses 3.2 % of the gap course
+        (its trench floor but a 3.5 cm band for each end), 0.5 % / 0.9 %
+        (front / hind) of board AE, 0.8 % / 1.0 % of AD, none of AC, Y,
+        barrier or steps. On the gap (``bench_littledog.py --expansions
+        40000 --classes gap``, session-15 defaults, session 16) it ends
+        seed 0's hooked shank: 6.51 → 7.98 cm/s, no reflex, and seed 1
+        6.64 → 7.96, so seeds 0–3 walk 7.14 → 7.24 cm/s; but over seeds
+        0–5 7.18 → 7.11 cm/s (6/6 both): seeds 2, 4 and 5 (7.79, 7.27,
+        7.26 → 5.36, 6.81, 6.86) put their front feet deeper into the
+        trench, and as LF swings down to it the lowered, tilted trunk tips
+        over the RF–LH diagonal, unloading RH (the foot-force reflex; the
+        mode of seed 1 without the check). At 6.5 cm seed 5 rolls over, and
+        a recovery that leaves a front foot on a refused trench cell (seed 2
+        with ``zmp.min_support_load`` 5 N) has no re-plan start.
+    wall_height:
+        How far above a foot's sole [m] a wall within ``wall_reach`` may rise
+        (9 cm: the knee stands 10–11 cm above the sole, less its 1 cm
+        radius). Smaller also refuses footholds beside lower walls, which the
+        knee clears.
 
     """
 
@@ -347,6 +378,8 @@ class FootstepConfig:
     edge_drop: float = 0.0
     edge_margin: float = 0.0
     max_foothold_slope: float = math.pi / 2
+    wall_reach: float = 0.0
+    wall_height: float = 0.09
 
     def __post_init__(self) -> None:
         _check("resolution", self.resolution, strict=True)
@@ -394,6 +427,8 @@ class FootstepConfig:
         _check("edge_drop", self.edge_drop)
         _check("edge_margin", self.edge_margin)
         _check("max_foothold_slope", self.max_foothold_slope)
+        _check("wall_reach", self.wall_reach)
+        _check("wall_height", self.wall_height)
         if not math.isfinite(self.crossing_margin) or not math.isfinite(self.cost_heading):
             raise ConfigError("footstep.crossing_margin and footstep.cost_heading must be finite")
         if self.incircle_preferred < self.incircle_min:
@@ -495,6 +530,8 @@ class FootstepConfig:
             "edge_drop",
             "edge_margin",
             "max_foothold_slope",
+            "wall_reach",
+            "wall_height",
         ):
             d.pop(key)
         return d

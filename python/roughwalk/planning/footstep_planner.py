@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 
 from roughwalk import _core
 from roughwalk.errors import InvalidArgumentError, PlanningError, TerrainError
-from roughwalk.planning.foothold_safety import unsafe_footholds
+from roughwalk.planning.foothold_safety import unsafe_footholds, wall_footholds
 from roughwalk.planning.footstep_config import LEG_INDEX, FootstepConfig
 from roughwalk.planning.footstep_cost import FootholdCost, default_terrain_cost
 from roughwalk.planning.footstep_plan import (
@@ -110,6 +110,16 @@ class FootstepPlanner:
             )
             self.cost_front = np.where(unsafe, np.inf, self.cost_front)
             self.cost_hind = np.where(unsafe, np.inf, self.cost_hind)
+        if c.wall_reach > 0:
+            # Where a knee would meet a wall's rim, for each end's knees.
+            for end in ("front", "hind"):
+                at_wall = wall_footholds(
+                    terrain, robot.foot_radius, c.wall_reach, c.wall_height, heading, end
+                )
+                if end == "front":
+                    self.cost_front = np.where(at_wall, np.inf, self.cost_front)
+                else:
+                    self.cost_hind = np.where(at_wall, np.inf, self.cost_hind)
         t2 = time.perf_counter()
         collision = CollisionModel.from_robot(robot)
         body = ~collision.is_foot
