@@ -52,7 +52,9 @@ def _problem_args(p: argparse.ArgumentParser) -> None:
         help="a cost weight that differs from melon_config's, as for roughwalk optimize "
         "(repeatable, dotted names: costs.force_between_nodes_penalty=10, costs.force.weight=0.1), "
         "or a learned solve's restart setting (solver.guess_fallback_after=40, "
-        "solver.dear_guess_restarts=0: a learned run folder records them)",
+        "solver.dear_guess_restarts=0: a learned run folder records them), "
+        "or swing_base_clearance=0.5 (the trunk's least height over a swinging foot, "
+        "a fraction of the nominal height; the run and its model record it)",
     )
 
 
@@ -177,6 +179,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         ProblemSpec,
         constraint_set,
         cost_weights,
+        nlp_settings,
         solver_settings,
     )
 
@@ -191,6 +194,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         None if args.constraints is None else constraint_set(args.constraints),
         cost_weights(args.set),
         solver_settings(args.set),
+        **{"swing_base_clearance": space.swing_base_clearance, **nlp_settings(args.set)},
     )
     out = args.out or DEFAULT_ROOT / f"{space.name}_{args.gait}{spec.steps}_{args.split}"
     seeds = parse_nearest(args.init)

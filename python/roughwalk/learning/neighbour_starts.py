@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from roughwalk.errors import ConfigError
 from roughwalk.learning.executors import Executor
 from roughwalk.learning.filtering import VIOLATION_TOL, feasible_mask
-from roughwalk.learning.problem_spec import ProblemSpec
+from roughwalk.learning.problem_spec import NLP_SETTINGS, ProblemSpec
 from roughwalk.learning.task_space import TaskSpace
 from roughwalk.trajopt import Task
 
@@ -112,17 +112,30 @@ def seed_pool(spec: ProblemSpec, space: TaskSpace, folders: Sequence[Path]) -> S
     from roughwalk.learning.experience import read_run
 
     pool = SolvedPool.for_space(space)
+    wanted = _rows_and_variables(spec.to_dict())
     for folder in folders:
         data = read_run(folder)
         problem = data.meta.get("problem")
-        if problem != spec.to_dict():
+        if not isinstance(problem, dict) or _rows_and_variables(problem) != wanted:
             raise ConfigError(
                 f"{folder} holds solves of another problem ({problem!r}); nearest starts "
-                f"need solves of {spec.to_dict()!r}"
+                f"need solves of {spec.to_dict()!r} (it may differ in "
+                f"{', '.join(NLP_SETTINGS)})"
             )
         for k in np.flatnonzero(feasible_mask(data)):
             pool.add({name: data[name][k] for name in data.columns})
     return pool
+
+
+def _rows_and_variables(problem: dict[str, Any]) -> dict[str, Any]:
+    """``problem`` without :data:`NLP_SETTINGS`: what fixes the solution's and rows' shape.
+
+    A seed run's solves only start the solves: one made at another
+    ``swing_base_clearance`` (the same rows, other bounds) is as good a
+    start; the run records its own problem, so its solves are never mixed
+    with the seeds' in training.
+    """
+    return {k: v for k, v in problem.items() if k not in NLP_SETTINGS}
 
 
 def neighbour_solves(
