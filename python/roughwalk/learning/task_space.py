@@ -23,6 +23,14 @@ up to 1.92 m, in 6.875 s up to 2.10 m (x = −0.30; farther starts have no
 converged solve yet), 24 steps in 8.25 s no farther. A box
 0.5–1.5 m back from the upper step instead would put front feet on the
 lower pallet: 13 of the 30 held-out starts then have no level stance.
+
+The double pallet's walk also lets the trunk come within 0.5 × its nominal
+height of a swinging foot (``swing_base_clearance``; stance feet keep 0.7).
+At 0.7 a front foot swinging onto the top holds the trunk 0.72 m up while
+the hind feet stand on the ground, and no start behind x = −0.30 converged.
+At 0.5 solves grown from converged neighbours converge across the whole box
+(session 16: 516 of 539 starts at x ≤ 0.1, 125 of 143 behind x = −0.30,
+down to x = −0.50).
 """
 
 from __future__ import annotations
@@ -184,7 +192,12 @@ def _triple(value: Any) -> tuple[float, float, float]:
 ENVIRONMENTS: dict[str, TaskSpace] = {
     "single_pallet": TaskSpace.for_terrain("single_pallet", (1.6, 0.0, 0.0), edge_x=1.0),
     "double_pallet": TaskSpace.for_terrain(
-        "double_pallet", (1.8, 0.0, 0.0), edge_x=1.0, steps=20, duration=6.875
+        "double_pallet",
+        (1.8, 0.0, 0.0),
+        edge_x=1.0,
+        steps=20,
+        duration=6.875,
+        swing_base_clearance=0.5,
     ),
     "flat": TaskSpace.for_terrain("flat", (1.5, 0.0, 0.0), edge_x=1.0),
 }
