@@ -87,9 +87,10 @@ def _models(folder: Path | None, env: str) -> list[tuple[str, LearnedModel]]:
     for path in shipped_models():
         model = LearnedModel.load(path)
         problem = model.header["problem"]
-        walk = (problem["steps"], problem["duration"])
+        walk = (problem["steps"], problem["duration"], problem.get("swing_base_clearance"))
         # The environment's walk only: the double pallet also ships a 16-step model.
-        if problem["terrain"] == space.terrain and walk == (space.steps, space.duration):
+        ours = (space.steps, space.duration, space.swing_base_clearance)
+        if problem["terrain"] == space.terrain and walk == ours:
             k = model.header["training"]["learned_init_round"]
             out.append((f"LearnedInit-{k} (shipped)", model))
     return out
@@ -148,7 +149,14 @@ def _set_suffix(spec: ProblemSpec) -> str:
 def spec_of_models(env: str, models: list[tuple[str, LearnedModel]]) -> ProblemSpec:
     """The held-out problem: every initialiser solves the newest model's constraints and costs."""
     space = task_space(env)
-    spec = ProblemSpec("anymal_c", space.terrain, "walk", space.steps, space.duration)
+    spec = ProblemSpec(
+        "anymal_c",
+        space.terrain,
+        "walk",
+        space.steps,
+        space.duration,
+        swing_base_clearance=space.swing_base_clearance,
+    )
     if not models:
         return spec
     model = models[-1][1]

@@ -108,16 +108,30 @@ def held_out_tasks(env: str, n: int, seed: int = 0) -> tuple[str, list[Any], str
 
 def walk(env: str) -> tuple[int, float]:
     """(steps, duration [s]) ``env``'s tasks are walked in: its task space's, else 16 in 5.5 s."""
+    space = _named_space(env)
+    return (STEPS, DURATION) if space is None else (space.steps, space.duration)
+
+
+def swing_clearance(env: str, trajopt: tuple[tuple[str, str], ...] = ()) -> float | None:
+    """``env``'s walk's ``swing_base_clearance`` (its task space's) unless ``--trajopt`` sets it."""
+    chosen = dict(trajopt).get("swing_base_clearance")
+    if chosen is not None:
+        return None if chosen.lower() == "none" else float(chosen)
+    space = _named_space(env)
+    return None if space is None else space.swing_base_clearance
+
+
+def _named_space(env: str) -> Any:
+    """``env``'s task space, or None (no learning wing, or not a named environment)."""
     try:
         from roughwalk.errors import ConfigError
         from roughwalk.learning import task_space
     except ImportError:
-        return STEPS, DURATION
+        return None
     try:
-        space = task_space(env)
+        return task_space(env)
     except ConfigError:
-        return STEPS, DURATION
-    return space.steps, space.duration
+        return None
 
 
 def learned_available() -> str:
@@ -132,7 +146,12 @@ def learned_available() -> str:
     return ""
 
 
-def learned_init(env: str, optimize_durations: bool, models: Path | None) -> str:
+def learned_init(
+    env: str,
+    optimize_durations: bool,
+    models: Path | None,
+    trajopt: tuple[tuple[str, str], ...] = (),
+) -> str:
     """The learned initialiser for this problem: the shipped model, or the one in ``models``.
 
     ``models`` is a folder of model files (``--models``); the first whose
@@ -147,26 +166,34 @@ def learned_init(env: str, optimize_durations: bool, models: Path | None) -> str
         from roughwalk.learning.model_file import LearnedModel
     except ImportError:
         return "learned"
-    signature = _spec(env, optimize_durations).to_dict()
+    signature = _spec(env, optimize_durations, trajopt).to_dict()
     for path in sorted(models.glob("*.npz")):
         if not LearnedModel.load(path).mismatches(signature):
             return f"learned:{path}"
     return f"learned:{models}"
 
 
-def learned_model_for(env: str, optimize_durations: bool, init: str = "learned") -> str:
+def learned_model_for(
+    env: str,
+    optimize_durations: bool,
+    init: str = "learned",
+    trajopt: tuple[tuple[str, str], ...] = (),
+) -> str:
     """Why ``init``'s model does not fit the problem of ``env`` ("" when it does)."""
     try:
         from roughwalk.learning.initializer import model_for_spec
 
-        model_for_spec(init, _spec(env, optimize_durations))
+        model_for_spec(init, _spec(env, optimize_durations, trajopt))
     except Exception as e:  # noqa: BLE001  (no model: run without it, and say why)
         return f"{type(e).__name__}: {e}"
     return ""
 
 
 def learned_problem(
-    env: str, optimize_durations: bool, init: str = "learned"
+    env: str,
+    optimize_durations: bool,
+    init: str = "learned",
+    trajopt: tuple[tuple[str, str], ...] = (),
 ) -> tuple[tuple[str, ...] | None, tuple[tuple[str, float], ...] | None]:
     """The constraint set and cost weights of ``init``'s learned model (None: the default).
 
@@ -181,12 +208,12 @@ def learned_problem(
         from roughwalk.learning.model_constraints import spec_for_learned
     except ImportError:
         return None, None
-    spec = spec_for_learned(_spec(env, optimize_durations), init)
+    spec = spec_for_learned(_spec(env, optimize_durations, trajopt), init)
     return spec.constraints, spec.costs
 
 
-def _spec(env: str, optimize_durations: bool) -> Any:
-    """The benchmark's problem of ``env`` as a learning ProblemSpec."""
+def _spec(env: str, optimize_durations: bool, trajopt: tuple[tuple[str, str], ...] = ()) -> Any:
+    """The benchmark's problem of ``env`` (with ``--trajopt``'s clearance) as a ProblemSpec."""
     from roughwalk.learning import ProblemSpec
 
     steps, duration = walk(env)
@@ -196,6 +223,7 @@ def _spec(env: str, optimize_durations: bool) -> Any:
         steps=steps,
         duration=duration,
         optimize_durations=optimize_durations,
+        swing_base_clearance=swing_clearance(env, trajopt),
     )
 
 
@@ -212,7 +240,11 @@ def job_config(job: Job) -> Any:
 
     steps, duration = walk(job.env)
     config = melon_config(
-        gait=GAIT, steps=steps, duration=duration, optimize_durations=job.optimize_durations
+        gait=GAIT,
+        steps=steps,
+        duration=duration,
+        optimize_durations=job.optimize_durations,
+        swing_base_clearance=swing_clearance(job.env),
     )
     if job.constraints is not None:
         config = replace(config, constraints=job.constraints)
@@ -567,10 +599,10 @@ def main() -> None:
             print(notes[-1])
         for name in inits:
             for opt in durations:
-                learned = learned_init(env, opt, args.models)
-                constraints, costs = learned_problem(env, opt, learned)
+                learned = learned_init(env, opt, args.models, trajopt)
+                constraints, costs = learned_problem(env, opt, learned, trajopt)
                 init = learned if name == "learned" else name
-                why = learned_model_for(env, opt, init) if name == "learned" else ""
+                why = learned_model_for(env, opt, init, trajopt) if name == "learned" else ""
                 if why:
                     notes.append(f"{env}: learned initialiser skipped ({why})")
                     print(notes[-1])

@@ -110,3 +110,49 @@ def test_only_feasible_solves_with_multipliers_join_the_pool() -> None:
     assert not pool.add({**row, "lam_g": np.full(2, np.nan)})
     assert len(pool) == 1
     np.testing.assert_allclose(pool.scale, [0.2, 0.2, 0.4, 1.0, 1.0, 1.0])
+
+
+def test_a_far_task_is_reached_by_a_chain_of_small_start_moves(
+    seed_run: Path, tmp_path: Path
+) -> None:
+    from roughwalk.learning.neighbour_starts import chain_links
+    from roughwalk.trajopt import Task
+
+    a, b = Task((0.0, 0.0, 0.0), (0.4, 0.0, 0.0)), Task((0.1, -0.1, 0.2), (0.4, 0.0, 0.0))
+    scale = np.array([0.2, 0.2, 0.4, 1.0, 1.0, 1.0])
+    distance = _scaled(np.array([*a.start, *a.goal]), np.array([*b.start, *b.goal]))
+    links = chain_links(a, b, distance, 0.25)
+    assert len(links) == int(np.ceil(distance / 0.25)) - 1 == 3
+    stops = [np.array([*t.start, *t.goal]) for t in (a, *links, b)]
+    for p, q in zip(stops, stops[1:], strict=False):
+        assert np.sqrt((((q - p) / scale) ** 2).sum()) <= 0.25 + 1e-12
+    seed = read_run(seed_run)
+    pool = [
+        (np.concatenate([s, g]), x)
+        for s, g, x in zip(seed["start"], seed["goal"], seed["x"], strict=True)
+    ]
+    order: list[dict[str, Any]] = []
+    generate(
+        SPEC,
+        SPACE,
+        4,
+        tmp_path / "chained",
+        progress=None,
+        max_iter=LIMIT,
+        seeds=[seed_run],
+        chain_step=0.05,
+        on_solved=order.append,
+    )
+    chained = 0
+    for row in order:
+        task = np.concatenate([row["start"], row["goal"]])
+        if min(_scaled(task, t) for t, _ in pool) > 0.05:
+            # Reached in moves: started from its last link's solution, no solved task's.
+            assert all(not np.array_equal(row["x0"], x) for _, x in pool)
+            assert row["max_violation"] <= 1e-3
+            chained += 1
+        if row["max_violation"] <= 1e-3:
+            pool.append((task, row["x"]))
+    assert chained >= 1
+    meta = json.loads((tmp_path / "chained" / "run.json").read_text())
+    assert meta["chain_step"] == 0.05

@@ -91,6 +91,16 @@ def test_the_tracking_bench_finds_a_shipped_model_of_the_double_pallet_s_walk() 
     space = task_space("double_pallet")
     assert model.header["problem"]["steps"] == space.steps == 20
     assert model.header["problem"]["duration"] == space.duration
+    # The walk's trunk may come within 0.5 h of a swinging foot, and its model is trained so.
+    assert model.header["problem"]["swing_base_clearance"] == space.swing_base_clearance == 0.5
+    assert (
+        bench.job_config(
+            bench.Job(
+                "double_pallet", "double_pallet", "learned", 0, False, 0, (0, 0, 0), space.goal
+            )
+        ).swing_base_clearance
+        == 0.5
+    )
 
 
 def test_the_init_bench_takes_the_shipped_model_of_the_environment_s_walk() -> None:

@@ -16,7 +16,7 @@ from roughwalk.learning import LearnedModel  # noqa: E402
 from roughwalk.learning.initializer import MODELS_DIR  # noqa: E402
 from roughwalk.trajopt.parameters import MELON_REACH_CONSTRAINTS  # noqa: E402
 
-DOUBLE = MODELS_DIR / "anymal_c_double_pallet_walk20.npz"
+DOUBLE = MODELS_DIR / "anymal_c_double_pallet_walk20_swing05.npz"  # the walk's model
 
 
 @pytest.fixture

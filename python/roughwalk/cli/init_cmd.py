@@ -52,7 +52,9 @@ def _problem_args(p: argparse.ArgumentParser) -> None:
         help="a cost weight that differs from melon_config's, as for roughwalk optimize "
         "(repeatable, dotted names: costs.force_between_nodes_penalty=10, costs.force.weight=0.1), "
         "or a learned solve's restart setting (solver.guess_fallback_after=40, "
-        "solver.dear_guess_restarts=0: a learned run folder records them)",
+        "solver.dear_guess_restarts=0: a learned run folder records them), "
+        "or swing_base_clearance=0.5 (the trunk's least height over a swinging foot, "
+        "a fraction of the nominal height; the run and its model record it)",
     )
 
 
@@ -104,6 +106,13 @@ def register(sub: Any) -> None:
         "--start-x-min",
         type=float,
         help="solve only the tasks (of the first --tasks) whose start x is at least this (m)",
+    )
+    g.add_argument(
+        "--chain-step",
+        type=float,
+        help="with --init nearest: reach a task farther than this from its nearest solve "
+        "(task features over the start box's widths, so 0.05 is 5 cm of x on a 1 m box) in "
+        "start moves of at most this, each solved from the last",
     )
     g.set_defaults(func=cmd_generate)
 
@@ -177,6 +186,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         ProblemSpec,
         constraint_set,
         cost_weights,
+        nlp_settings,
         solver_settings,
     )
 
@@ -191,6 +201,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         None if args.constraints is None else constraint_set(args.constraints),
         cost_weights(args.set),
         solver_settings(args.set),
+        **{"swing_base_clearance": space.swing_base_clearance, **nlp_settings(args.set)},
     )
     out = args.out or DEFAULT_ROOT / f"{space.name}_{args.gait}{spec.steps}_{args.split}"
     seeds = parse_nearest(args.init)
@@ -230,6 +241,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         jitter_seed=args.jitter_seed,
         seeds=seeds,
         batch=args.workers,
+        chain_step=args.chain_step,
     )
     solved = int(sum(s in ("exact", "approximate") for s in data["status"]))
     print(f"{len(data)} tasks in {out / 'dataset.npz'}: {solved} converged")

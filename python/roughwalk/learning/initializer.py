@@ -82,15 +82,22 @@ def _pick(signature: dict[str, object]) -> LearnedModel:
     have = "; ".join(
         f"{m.name} ({m.header['problem']['robot']}, {m.header['problem']['terrain']}, "
         f"{m.header['problem']['gait']} {m.header['problem']['steps']} steps, "
-        f"{m.header['problem']['duration']} s)"
+        f"{m.header['problem']['duration']} s"
+        f"{_clearance(m.header['problem'].get('swing_base_clearance'))})"
         for m in models
     )
     raise ConfigError(
         f"no shipped learned model fits robot {signature.get('robot')!r}, terrain "
         f"{signature.get('terrain')!r}, gait {signature.get('gait')!r}, "
-        f"{signature.get('steps')} steps, {signature.get('duration')} s; shipped: "
+        f"{signature.get('steps')} steps, {signature.get('duration')} s"
+        f"{_clearance(signature.get('swing_base_clearance'))}; shipped: "
         f"{have or 'none'}; train one with `roughwalk init` and use learned:MODEL"
     )
+
+
+def _clearance(value: object) -> str:
+    """', swing_base_clearance 0.5' for a set clearance, '' for None (as base_clearance)."""
+    return "" if value is None else f", swing_base_clearance {value}"
 
 
 def model_for_spec(init: str, spec: ProblemSpec) -> LearnedModel:

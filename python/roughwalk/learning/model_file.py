@@ -1,12 +1,12 @@
 """A learned initialiser on disk: MLP arrays in an .npz and a JSON header, never a pickle.
 
 The header records what the model is for — task space, robot, terrain, gait,
-step count, duration, fixed or optimised phase durations and the NLP's
-variable layout — and how it was made (tasks seen, D_good's size, g_max,
-LearnedInit round, held-out figures). A problem that differs in any of
-these is refused with a message naming what differs, since Melon et al.'s
-initialiser is specific to one environment and one variable layout (Melon
-2020, §IV-A).
+step count, duration, fixed or optimised phase durations, the trunk's
+clearance over swinging feet and the NLP's variable layout — and how it was
+made (tasks seen, D_good's size, g_max, LearnedInit round, held-out
+figures). A problem that differs in any of these is refused with a message
+naming what differs, since Melon et al.'s initialiser is specific to one
+environment and one variable layout (Melon 2020, §IV-A).
 """
 
 from __future__ import annotations
@@ -33,7 +33,18 @@ MODEL_FORMAT = "roughwalk.learned_init"
 MODEL_VERSION = 1
 FEATURES = ("start_x", "start_y", "start_yaw", "goal_x", "goal_y", "goal_yaw")
 # What must match, in the order a mismatch is reported.
-_CHECKED = ("robot", "gait", "steps", "duration", "optimize_durations", "terrain")
+_CHECKED = (
+    "robot",
+    "gait",
+    "steps",
+    "duration",
+    "optimize_durations",
+    "terrain",
+    "swing_base_clearance",
+)
+# Checked even where a signature leaves them out: absent means this value (a
+# spec's to_dict and every header made before the field leave out None).
+_ABSENT_MEANS = {"swing_base_clearance": None}
 
 Start = tuple[NDArray[np.floating], NDArray[np.floating] | None, NDArray[np.floating] | None]
 """A start for IPOPT: the guess, its bound multipliers and constraint multipliers (or None)."""
@@ -53,6 +64,7 @@ def problem_signature(nlp: Formulation) -> dict[str, Any]:
         "duration": float(nlp.schedule.total_duration),
         "optimize_durations": bool(nlp.config.optimize_durations),
         "terrain": nlp.terrain.name,
+        "swing_base_clearance": nlp.config.swing_base_clearance,
         "layout": [[v.name, v.size] for v in nlp.variable_sets],
     }
 
@@ -198,8 +210,12 @@ class LearnedModel:
         mine = {**self.header["problem"], "layout": self.header["layout"]}
         out = []
         for key in _CHECKED:
-            if key in signature and _norm(mine.get(key)) != _norm(signature[key]):
-                out.append(f"{key} is {mine.get(key)!r} in the model but {signature[key]!r} here")
+            if key not in signature and key not in _ABSENT_MEANS:
+                continue
+            theirs = signature.get(key, _ABSENT_MEANS.get(key))
+            if _norm(mine.get(key, _ABSENT_MEANS.get(key))) != _norm(theirs):
+                ours = mine.get(key, _ABSENT_MEANS.get(key))
+                out.append(f"{key} is {ours!r} in the model but {theirs!r} here")
         layout_differs = _norm(mine["layout"]) != _norm(signature.get("layout", mine["layout"]))
         if not out and layout_differs:
             theirs = {n: s for n, s in signature["layout"]}

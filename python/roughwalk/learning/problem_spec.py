@@ -10,7 +10,7 @@ process (:func:`build_problem` caches it) and describes its variable layout.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -41,6 +41,8 @@ __all__ = [
     "constraint_set",
     "task_refusal",
     "cost_weights",
+    "NLP_SETTINGS",
+    "nlp_settings",
     "LEARNED_SOLVE_SETTINGS",
     "UNRECORDED_SOLVE_SETTINGS",
     "solve_settings",
@@ -56,6 +58,15 @@ CONSTRAINT_SETS: dict[str, tuple[str, ...]] = {
     "towr": TOWR_CONSTRAINTS,
 }
 """Named constraint sets (``roughwalk init generate --constraints NAME``)."""
+
+NLP_SETTINGS = ("swing_base_clearance",)
+"""Top-level :class:`~roughwalk.trajopt.TrajoptConfig` fields a :class:`ProblemSpec` may set.
+
+They change the NLP's rows (here their bounds), not its variable layout, so
+a model trained under one value starts IPOPT at the optimum of another
+problem: a run folder and a model header record them, and a problem that
+differs is refused (``roughwalk init generate --set swing_base_clearance=0.5``).
+"""
 
 LEARNED_SOLVE_SETTINGS = ("guess_fallback_after", "dear_guess_restarts")
 """The ``solver`` fields that change where a solve from a learned guess ends.
@@ -115,6 +126,12 @@ class ProblemSpec:
         defaults. Never in :meth:`to_dict`: they change how a solve from a
         learned guess restarts, not the NLP a model fits, and a run records
         all of them, defaults too, under "solver" (:func:`solve_settings`).
+    swing_base_clearance:
+        Least height of the base above a swinging foot, as a fraction of the
+        nominal base height (:class:`~roughwalk.trajopt.TrajoptConfig`'s
+        field); None: as ``base_clearance`` (0.7), the problem of every run
+        and model made before the field existed (left out of :meth:`to_dict`
+        then, so that they still resume and fit).
 
     """
 
@@ -127,6 +144,7 @@ class ProblemSpec:
     constraints: tuple[str, ...] | None = None
     costs: tuple[tuple[str, float], ...] | None = None
     solver: tuple[tuple[str, int | None], ...] | None = None
+    swing_base_clearance: float | None = None
 
     def config(self) -> TrajoptConfig:
         """Melon et al.'s configuration for this problem."""
@@ -140,6 +158,8 @@ class ProblemSpec:
             optimize_durations=self.optimize_durations,
             **changes,
         )
+        if self.swing_base_clearance is not None:
+            config = replace(config, swing_base_clearance=float(self.swing_base_clearance))
         if self.costs:
             config = override(config, {f"costs.{k}": v for k, v in self.costs})
         if self.solver:
@@ -147,9 +167,11 @@ class ProblemSpec:
         return config
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data for JSON (``constraints`` and ``costs`` only when not the defaults)."""
+        """Plain data for JSON (``constraints``, ``costs``, the clearance only when set)."""
         data = asdict(self)
         del data["solver"]
+        if self.swing_base_clearance is None:
+            del data["swing_base_clearance"]
         if self.constraints is None:
             del data["constraints"]
         else:
@@ -177,6 +199,9 @@ class ProblemSpec:
                 costs=None
                 if data.get("costs") is None
                 else tuple(sorted((str(k), float(v)) for k, v in data["costs"].items())),
+                swing_base_clearance=None
+                if data.get("swing_base_clearance") is None
+                else float(data["swing_base_clearance"]),
             )
         except KeyError as e:
             raise ConfigError(f"problem spec lacks the field {e}; got {sorted(data)}") from None
@@ -215,13 +240,13 @@ def cost_weights(items: Iterable[str]) -> tuple[tuple[str, float], ...] | None:
     weights = melon_config().costs
     known = cost_leaves(weights)
     for key, value in parse_set(items).items():
-        if key.startswith("solver."):
-            continue  # solver_settings's
+        if key.startswith("solver.") or key in NLP_SETTINGS:
+            continue  # solver_settings's, nlp_settings's
         name = key.removeprefix("costs.")
         if name == key or name not in known:
             raise ConfigError(
                 f"--set {key}={value}: not a cost weight; give costs.NAME=VALUE with NAME "
-                f"among {', '.join(known)}"
+                f"among {', '.join(known)} (or one of {', '.join(NLP_SETTINGS)}=VALUE)"
             )
         try:
             weights = override(weights, {name: value})
@@ -229,6 +254,23 @@ def cost_weights(items: Iterable[str]) -> tuple[tuple[str, float], ...] | None:
             raise ConfigError(f"--set {key}={value}: {e}") from None
     changes = cost_changes(weights)
     return tuple(sorted(changes.items())) if changes else None
+
+
+def nlp_settings(items: Iterable[str]) -> dict[str, float | None]:
+    """``NAME=VALUE`` items of ``--set`` whose NAME is one of :data:`NLP_SETTINGS`, as values.
+
+    Checked against :func:`~roughwalk.trajopt.melon_config` ("none" for None);
+    items of other sections (``costs.``, ``solver.``) are left to
+    :func:`cost_weights` and :func:`solver_settings`. Give the result to
+    :class:`ProblemSpec` as keywords.
+    """
+    config = melon_config()
+    chosen = {k: v for k, v in parse_set(items).items() if k in NLP_SETTINGS}
+    try:
+        config = override(config, chosen)
+    except ConfigError as e:
+        raise ConfigError(f"--set {chosen}: {e}") from None
+    return {name: getattr(config, name) for name in chosen}
 
 
 def solver_settings(items: Iterable[str]) -> tuple[tuple[str, int | None], ...] | None:

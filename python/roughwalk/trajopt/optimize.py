@@ -639,6 +639,7 @@ def optimize_motion(
             "steps": schedule.steps,
             "duration": float(schedule.total_duration),
             "optimize_durations": bool(cfg.optimize_durations),
+            "swing_base_clearance": cfg.swing_base_clearance,
         }
         chosen = tuple(choose(tuple(cfg.constraints), signature))
         if chosen != tuple(cfg.constraints):
