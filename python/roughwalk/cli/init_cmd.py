@@ -107,13 +107,6 @@ def register(sub: Any) -> None:
         type=float,
         help="solve only the tasks (of the first --tasks) whose start x is at least this (m)",
     )
-    g.add_argument(
-        "--chain-step",
-        type=float,
-        help="with --init nearest: reach a task farther than this from its nearest solve "
-        "(task features over the start box's widths, so 0.05 is 5 cm of x on a 1 m box) in "
-        "start moves of at most this, each solved from the last",
-    )
     g.set_defaults(func=cmd_generate)
 
     t = s.add_parser("train", help="filter a dataset and fit the learned initialiser")
@@ -241,7 +234,6 @@ def cmd_generate(args: argparse.Namespace) -> int:
         jitter_seed=args.jitter_seed,
         seeds=seeds,
         batch=args.workers,
-        chain_step=args.chain_step,
     )
     solved = int(sum(s in ("exact", "approximate") for s in data["status"]))
     print(f"{len(data)} tasks in {out / 'dataset.npz'}: {solved} converged")

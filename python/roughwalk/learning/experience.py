@@ -379,7 +379,6 @@ def generate(
     jitter_seed: int = 0,
     seeds: Sequence[str | Path] | None = None,
     batch: int = 1,
-    chain_step: float | None = None,
 ) -> Dataset:
     """Solve tasks 0..n_tasks−1 of ``space``'s ``split`` into ``folder``; resume what is there.
 
@@ -418,11 +417,6 @@ def generate(
         of this run, nearest tasks first, ``batch`` (the executor's workers)
         at a time (:mod:`~roughwalk.learning.neighbour_starts`); ``init``
         names them (``nearest:RUN,...``).
-    chain_step:
-        With ``seeds``: a task farther than this scaled distance from its
-        nearest solve is reached in start moves of at most this
-        (:class:`~roughwalk.learning.neighbour_starts.ChainJob`). Recorded in
-        the run.
 
     Returns
     -------
@@ -437,8 +431,6 @@ def generate(
         )
     if seeds is not None and model is not None:
         raise ConfigError("a run starts from a model's guesses or from seed runs' solves, not both")
-    if chain_step is not None and seeds is None:
-        raise ConfigError("chain_step moves from a solved neighbour: give seed runs (nearest)")
     if seeds is not None:
         init = f"{NEAREST_INIT}:{','.join(str(f) for f in seeds)}"
     run = ExperienceRun(
@@ -459,7 +451,6 @@ def generate(
             "max_iter": max_iter,
             # Only when given: runs made before jitter existed resume as before.
             **({} if jitter is None else {"jitter": [*map(float, jitter), int(jitter_seed)]}),
-            **({} if chain_step is None else {"chain_step": float(chain_step)}),
             # How a learned solve restarts (a heuristic solve uses none of it).
             **({} if model is None else {"solver": solve_settings(spec)}),
         },
@@ -523,7 +514,7 @@ def generate(
         pool = seed_pool(spec, space, [Path(f) for f in seeds])
         for row in run.rows():
             pool.add(row)
-        results = neighbour_solves(spec, todo, tasks, pool, max_iter, executor, batch, chain_step)
+        results = neighbour_solves(spec, todo, tasks, pool, max_iter, executor, batch)
     for row in results:
         run.record(row)
         finished += 1

@@ -12,14 +12,6 @@ the pool at once, so the solved set grows outwards from its seeds (the
 feasible solves of earlier run folders of the same problem, and the run's
 own). The distance is over the task features divided by the task space's
 box width (1 where the box is flat, e.g. a fixed goal).
-
-Where the nearest solve lies farther than ``chain_step`` (a scaled
-distance), the task is reached by a chain of small start moves
-(:class:`ChainJob`): intermediate tasks on the straight line from the
-neighbour's task to this one, each solved from the previous solution; the
-task itself last, from the farthest link that converged. Session 15 found
-that on the double pallet a chain of four moves from a converged solve
-reached starts where a solve from the nearest neighbour 0.1 m away did not.
 """
 
 from __future__ import annotations
@@ -39,14 +31,7 @@ from roughwalk.learning.problem_spec import NLP_SETTINGS, ProblemSpec
 from roughwalk.learning.task_space import TaskSpace
 from roughwalk.trajopt import Task
 
-__all__ = [
-    "NEAREST_INIT",
-    "ChainJob",
-    "SolvedPool",
-    "chain_job",
-    "neighbour_solves",
-    "parse_nearest",
-]
+__all__ = ["NEAREST_INIT", "SolvedPool", "neighbour_solves", "parse_nearest"]
 
 NEAREST_INIT = "nearest"
 """``--init nearest:RUN[,RUN...]``: start each task at its nearest solved neighbour's solution."""
@@ -153,50 +138,6 @@ def _rows_and_variables(problem: dict[str, Any]) -> dict[str, Any]:
     return {k: v for k, v in problem.items() if k not in NLP_SETTINGS}
 
 
-@dataclass(frozen=True)
-class ChainJob:
-    """Task ``index`` reached from a solved task's start in small start moves.
-
-    ``links`` are the intermediate tasks, nearest the solved one first; each
-    is solved from the previous solution and multipliers (the first from
-    ``x0``), and the task itself from the last link that converged.
-    """
-
-    spec: ProblemSpec
-    index: int
-    task: Task
-    max_iter: int
-    x0: NDArray[np.float64]
-    lam_x0: NDArray[np.float64]
-    lam_g0: NDArray[np.float64]
-    links: tuple[Task, ...]
-
-
-def chain_job(job: ChainJob) -> dict[str, Any]:
-    """Solve ``job``'s links in order, then its task; the task's row (the links' are not kept)."""
-    from roughwalk.learning.experience import SolveJob, solve_job
-
-    x0, lam_x0, lam_g0 = job.x0, job.lam_x0, job.lam_g0
-    for link in job.links:
-        row = solve_job(SolveJob(job.spec, job.index, link, job.max_iter, x0, lam_x0, lam_g0))
-        if not float(row["max_violation"]) <= VIOLATION_TOL:
-            break
-        x0, lam_x0, lam_g0 = row["x"], row["lam_x"], row["lam_g"]
-    return solve_job(SolveJob(job.spec, job.index, job.task, job.max_iter, x0, lam_x0, lam_g0))
-
-
-def chain_links(start: Task, end: Task, distance: float, chain_step: float) -> tuple[Task, ...]:
-    """Tasks between ``start`` and ``end`` (excluded) at most ``chain_step`` apart (scaled)."""
-    moves = int(np.ceil(distance / chain_step - 1e-9))
-    a = np.array([*start.start, *start.goal], dtype=float)
-    b = np.array([*end.start, *end.goal], dtype=float)
-    out = []
-    for k in range(1, moves):
-        f = a + (b - a) * k / moves
-        out.append(Task((f[0], f[1], f[2]), (f[3], f[4], f[5])))
-    return tuple(out)
-
-
 def neighbour_solves(
     spec: ProblemSpec,
     indices: Sequence[int],
@@ -205,19 +146,14 @@ def neighbour_solves(
     max_iter: int,
     executor: Executor,
     batch: int = 1,
-    chain_step: float | None = None,
 ) -> Iterator[dict[str, Any]]:
     """Solve ``tasks`` nearest-to-the-pool first, each from its nearest solve; yield the rows.
 
     ``batch`` tasks are handed to ``executor`` at a time (its worker
     count); each yielded feasible row joins ``pool`` before the next batch
-    is chosen. With ``chain_step`` (a scaled distance), a task farther than
-    that from its nearest solve is reached by a :class:`ChainJob`.
+    is chosen.
     """
-    from roughwalk.learning.experience import SolveJob
-
-    if chain_step is not None and not chain_step > 0:
-        raise ConfigError(f"chain_step must be > 0 (a scaled task distance), got {chain_step}")
+    from roughwalk.learning.experience import SolveJob, solve_job
 
     if len(pool) == 0 and len(tasks):
         raise ConfigError(
@@ -227,32 +163,13 @@ def neighbour_solves(
     while left:
         distance, nearest = pool.distances([tasks[k] for k in left])
         order = np.argsort(distance, kind="stable")[: max(batch, 1)]
-        jobs: list[SolveJob | ChainJob] = []
+        jobs = []
         for j in order:
             k = left[int(j)]
             x0, lam_x0, lam_g0 = pool.starts[int(nearest[j])]
-            if chain_step is not None and distance[j] > chain_step:
-                near = pool.tasks[int(nearest[j])]
-                links = chain_links(
-                    Task((near[0], near[1], near[2]), (near[3], near[4], near[5])),
-                    tasks[k],
-                    float(distance[j]),
-                    chain_step,
-                )
-                jobs.append(
-                    ChainJob(spec, indices[k], tasks[k], max_iter, x0, lam_x0, lam_g0, links)
-                )
-            else:
-                jobs.append(SolveJob(spec, indices[k], tasks[k], max_iter, x0, lam_x0, lam_g0))
+            jobs.append(SolveJob(spec, indices[k], tasks[k], max_iter, x0, lam_x0, lam_g0))
         chosen = {left[int(j)] for j in order}
         left = [k for k in left if k not in chosen]
-        for row in executor.run(_solve_or_chain, jobs):
+        for row in executor.run(solve_job, jobs):
             pool.add(row)
             yield row
-
-
-def _solve_or_chain(job: Any) -> dict[str, Any]:
-    """:func:`chain_job` for a :class:`ChainJob`, else the experience run's ``solve_job``."""
-    from roughwalk.learning.experience import solve_job
-
-    return chain_job(job) if isinstance(job, ChainJob) else solve_job(job)
