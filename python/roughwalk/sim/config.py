@@ -642,6 +642,14 @@ class ExecutorConfig:
         starts from those feet (as a re-plan's feet are snapped); 0: the
         start is refused. Larger puts the robot down farther from its
         nominal stance.
+    start_max_slope:
+        Steepest slope [rad] (the mean over the foot's disc, as
+        ``footstep.max_foothold_slope`` measures it) a foot of the start
+        stance may stand on: a steeper one moves onto the nearest foothold
+        within ``start_snap_m`` that is not, and the plan starts from
+        there. ≥ π/2: only the footstep settings' limit counts. A start
+        foot bears load through the first shifts and swings and, as no
+        re-plan moves a standing foot, through every recovery after them.
     """
 
     compute_time_scale: float = 1.0
@@ -649,11 +657,18 @@ class ExecutorConfig:
     plan_expansions: int = 0
     longest_step: float = 0.4
     start_snap_m: float = 0.015
+    start_max_slope: float = 0.5 * math.pi
 
     def __post_init__(self) -> None:
         _nonnegative(
             self,
-            ("compute_time_scale", "plan_expansions", "longest_step", "start_snap_m"),
+            (
+                "compute_time_scale",
+                "plan_expansions",
+                "longest_step",
+                "start_snap_m",
+                "start_max_slope",
+            ),
             "executor",
         )
         _positive(self, ("initial_plan_s",), "executor")
