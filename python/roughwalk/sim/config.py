@@ -338,6 +338,25 @@ class ReflexConfig:
         Trunk orientation error [rad] (angle of R̄Rᵀ) beyond which it fires.
     foot_position_m:
         A supporting foot this far [m] from where it should be (a slip).
+        0.02 since session 16 (0.035 before): a foot sliding down a rock
+        is caught before the trunk tips. Board AE (bench large rocks seed
+        3, ``--expansions 40000``): LF slid 2.2–2.8 cm while RF swung; at
+        0.035 the orientation reflex fired 0.1 s later, at 0.21 rad, and
+        the recovery's stance had no plan; at 0.02 the foot-position
+        reflex fires at 2.5 cm and the run reaches the goal (5.36 cm/s).
+        ``bench_littledog.py``'s runs with ``--expansions 40000``, main and
+        0.02 one process each: large rocks seeds 0–7 4/8 at 5.56 cm/s →
+        5/8 at 5.30 (seed 3 gained; seed 5 slower, 3.79 → 2.67, after 5
+        reflexes, not 2), logs seeds 0–5 4/6 at 7.52 → 4/6 at 7.71 (seed
+        1 2.92 → 3.69, 3 reflexes, not 4); round rocks, sloped rocks, gap,
+        barrier and steps seeds 0–1 walk every run as at 0.035 (no reflex
+        more); held-out large rocks seeds 8–15 5/8 at 5.47 → 4/8 at 6.40
+        (seed 15 lost: a re-plan after the earlier reflex found no plan;
+        seed 14 3.73 → 5.76): over 16 large-rocks seeds 9 either way. With
+        ``executor.start_max_slope`` 40° as well: large rocks 0–7 5/8 at
+        6.48, 8–15 5/8 at 7.41, logs 4/6 at 7.22. Of main's 31 reflexes on those large-rocks and logs runs 25
+        were foot-force ones and none a foot-position one: the slides that
+        end runs mostly happen inside recoveries, where no reflex watches.
     foot_force_n:
         While three feet support the robot, one planned to bear at least this
         much [N] that measures less than ``foot_force_fraction`` of its plan
@@ -506,7 +525,7 @@ class ReflexConfig:
     enabled: bool = True
     body_position_m: float = 0.04
     body_orientation_rad: float = 0.15
-    foot_position_m: float = 0.035
+    foot_position_m: float = 0.02
     foot_force_n: float = 2.0
     foot_force_fraction: float = 0.05
     foot_force_tilt_rad: float = 0.03
