@@ -354,9 +354,10 @@ class ReflexConfig:
         (seed 15 lost: a re-plan after the earlier reflex found no plan;
         seed 14 3.73 → 5.76): over 16 large-rocks seeds 9 either way. With
         ``executor.start_max_slope`` 40° as well: large rocks 0–7 5/8 at
-        6.48, 8–15 5/8 at 7.41, logs 4/6 at 7.22. Of main's 31 reflexes on those large-rocks and logs runs 25
-        were foot-force ones and none a foot-position one: the slides that
-        end runs mostly happen inside recoveries, where no reflex watches.
+        6.48, 8–15 5/8 at 7.41, logs 4/6 at 7.22. Of main's 31 reflexes
+        on those large-rocks and logs runs 25 were foot-force ones and none
+        a foot-position one: the slides that end runs mostly happen inside
+        recoveries, where no reflex watches.
     foot_force_n:
         While three feet support the robot, one planned to bear at least this
         much [N] that measures less than ``foot_force_fraction`` of its plan
@@ -669,6 +670,16 @@ class ExecutorConfig:
         there. ≥ π/2: only the footstep settings' limit counts. A start
         foot bears load through the first shifts and swings and, as no
         re-plan moves a standing foot, through every recovery after them.
+        Board AE, bench large rocks seeds 4 and 6 (``--expansions 40000``):
+        RF started on a 41–42° flank beside a 6 cm rim and both runs fell.
+        Session 16, 40° against off (``bench_littledog.py``'s runs, one
+        process each): large rocks seeds 0–7 4/8 at 5.56 cm/s (14 reflexes)
+        → 4/8 at 7.30 (7); seeds 8–15 5/8 at 5.47 → 5/8 at 7.23; logs seeds
+        0–5 4/6 at 7.52 → 4/6 at 7.22 (seed 1 lost, 5 gained); round rocks,
+        sloped rocks, gap, barrier, steps seeds 0–1 the same runs. Seeds 4
+        and 6 still fall: RF, moved 5 mm up the rock, slides off it. With
+        ``reflex.foot_position_m`` 0.02: large rocks 10/16 (9 without),
+        logs 4/6. Off by default: it buys speed, not yet success.
     """
 
     compute_time_scale: float = 1.0
