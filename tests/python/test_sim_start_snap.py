@@ -9,13 +9,16 @@ the foot on the rim goes onto the nearest foothold, as a re-plan's feet do.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
 import roughwalk as rw
 from roughwalk import _core
 from roughwalk.planning import FootstepConfig
-from roughwalk.sim.footstep_source import PlannerSource, PlanStart
+from roughwalk.planning.foothold_safety import steep_footholds
+from roughwalk.sim.footstep_source import PlannerSource, PlanStart, planner_config
 from roughwalk.terrain import Terrain
 
 pytestmark = pytest.mark.skipif(
@@ -57,3 +60,43 @@ def test_a_start_foot_on_a_rim_goes_onto_the_nearest_foothold(snap: float) -> No
     assert stance["RF"][2] == pytest.approx(0.04)
     for leg, k in (("LF", 0), ("LH", 2), ("RH", 3)):
         assert np.linalg.norm(stance[leg][:2] - nominal[k, :2]) < 0.004, leg
+
+
+def test_a_start_foot_on_a_flank_steeper_than_the_start_limit_moves_onto_gentler_ground(
+    littledog_board: Callable[[str], Terrain],
+) -> None:
+    """Board AE, bench large rocks seed 4 (``--expansions 40000``): RF's start on a 41° flank.
+
+    The footstep settings' 45° limit lets RF stand there; no re-plan moved
+    it, and the run fell after two reflexes. With ``executor.start_max_slope``
+    40° RF goes onto the nearest foothold no steeper than that.
+    """
+    robot = rw.load_robot("littledog")
+    board = littledog_board("AE")
+    config = planner_config(robot, 0.4, {})
+    start = (0.1877222442228947, 0.3047265510562872, 0.047624370570770416)
+    goal = np.array([0.459, 0.3045])
+    limit = np.radians(40.0)
+    steep = steep_footholds(board, robot.foot_radius, limit)
+
+    def stance(max_slope: float) -> dict[str, np.ndarray]:
+        source = PlannerSource(
+            robot, board, expansions=200, start_max_slope=max_slope, config=config
+        )
+        attempt = source.plan(PlanStart(pose=start), goal, 60.0)
+        assert attempt.ok, attempt.reason
+        return {f.leg: np.array([f.x, f.y]) for f in attempt.plan.footsteps[:4]}
+
+    def on_steep(xy: np.ndarray) -> bool:
+        i = int(round((xy[0] - board.x0) / board.dx))
+        j = int(round((xy[1] - board.y0) / board.dy))
+        return bool(steep[i, j])
+
+    before = stance(0.5 * np.pi)
+    assert on_steep(before["RF"])  # within the footstep settings' 45°, beyond 40°
+    after = stance(float(limit))
+    for leg, xy in after.items():
+        assert not on_steep(xy), leg
+        assert np.linalg.norm(xy - before[leg]) <= 0.015 + 1e-9, leg
+    assert np.linalg.norm(after["RF"] - before["RF"]) > 0.0
+    assert np.linalg.norm(after["LF"] - before["LF"]) < 1e-9  # a foot on gentle ground stays

@@ -367,3 +367,30 @@ def test_a_foot_force_reflex_per_leg_waits_for_one_foot_short_of_load_throughout
     lf = lambda k: [0] if k >= 10 else []  # noqa: E731
     assert _foot_force_hits(littledog, False, lf)[0] == 45
     assert _foot_force_hits(littledog, True, lf)[0] == 45
+
+
+def test_a_supporting_foot_sliding_2_5_cm_fires_the_default_foot_position_reflex(
+    littledog,
+) -> None:
+    """``reflex.foot_position_m``: board AE, bench large rocks seed 3 (``--expansions 40000``).
+
+    LF slid 2.2–2.8 cm down a rock while RF swung; at 3.5 cm no reflex
+    fired until the trunk had tipped 0.21 rad 0.1 s later, and the
+    recovery's stance had no plan. Caught at 2.5 cm, it reached the goal.
+    """
+    monitor = ReflexMonitor(ReflexConfig())
+    desired = standing_segment(littledog).sample(0.0)
+    measured = type("M", (), {})()
+    measured.base_pos = desired.base_pos.copy()
+    measured.base_quat = desired.base_quat.copy()
+    measured.foot_forces = desired.forces.copy()
+    hits = []
+    for k in range(80):
+        measured.time = 0.002 * k
+        measured.feet = desired.feet.copy()
+        if k >= 40:  # LF, down 0.08 s (settled), slides 2.5 cm
+            measured.feet[0, 0] -= 0.025
+        trigger = monitor.check(desired, measured)
+        if trigger is not None:
+            hits.append((k, trigger.kind, trigger.leg))
+    assert hits and hits[0] == (55, "foot_position", "LF")  # 40 + 0.03 s / 0.002 s

@@ -338,6 +338,26 @@ class ReflexConfig:
         Trunk orientation error [rad] (angle of R̄Rᵀ) beyond which it fires.
     foot_position_m:
         A supporting foot this far [m] from where it should be (a slip).
+        0.02 since session 16 (0.035 before): a foot sliding down a rock
+        is caught before the trunk tips. Board AE (bench large rocks seed
+        3, ``--expansions 40000``): LF slid 2.2–2.8 cm while RF swung; at
+        0.035 the orientation reflex fired 0.1 s later, at 0.21 rad, and
+        the recovery's stance had no plan; at 0.02 the foot-position
+        reflex fires at 2.5 cm and the run reaches the goal (5.36 cm/s).
+        ``bench_littledog.py``'s runs with ``--expansions 40000``, main and
+        0.02 one process each: large rocks seeds 0–7 4/8 at 5.56 cm/s →
+        5/8 at 5.30 (seed 3 gained; seed 5 slower, 3.79 → 2.67, after 5
+        reflexes, not 2), logs seeds 0–5 4/6 at 7.52 → 4/6 at 7.71 (seed
+        1 2.92 → 3.69, 3 reflexes, not 4); round rocks, sloped rocks, gap,
+        barrier and steps seeds 0–1 walk every run as at 0.035 (no reflex
+        more); held-out large rocks seeds 8–15 5/8 at 5.47 → 4/8 at 6.40
+        (seed 15 lost: a re-plan after the earlier reflex found no plan;
+        seed 14 3.73 → 5.76): over 16 large-rocks seeds 9 either way. With
+        ``executor.start_max_slope`` 40° as well: large rocks 0–7 5/8 at
+        6.48, 8–15 5/8 at 7.41, logs 4/6 at 7.22. Of main's 31 reflexes
+        on those large-rocks and logs runs 25 were foot-force ones and none
+        a foot-position one: the slides that end runs mostly happen inside
+        recoveries, where no reflex watches.
     foot_force_n:
         While three feet support the robot, one planned to bear at least this
         much [N] that measures less than ``foot_force_fraction`` of its plan
@@ -506,7 +526,7 @@ class ReflexConfig:
     enabled: bool = True
     body_position_m: float = 0.04
     body_orientation_rad: float = 0.15
-    foot_position_m: float = 0.035
+    foot_position_m: float = 0.02
     foot_force_n: float = 2.0
     foot_force_fraction: float = 0.05
     foot_force_tilt_rad: float = 0.03
@@ -642,6 +662,24 @@ class ExecutorConfig:
         starts from those feet (as a re-plan's feet are snapped); 0: the
         start is refused. Larger puts the robot down farther from its
         nominal stance.
+    start_max_slope:
+        Steepest slope [rad] (the mean over the foot's disc, as
+        ``footstep.max_foothold_slope`` measures it) a foot of the start
+        stance may stand on: a steeper one moves onto the nearest foothold
+        within ``start_snap_m`` that is not, and the plan starts from
+        there. ≥ π/2: only the footstep settings' limit counts. A start
+        foot bears load through the first shifts and swings and, as no
+        re-plan moves a standing foot, through every recovery after them.
+        Board AE, bench large rocks seeds 4 and 6 (``--expansions 40000``):
+        RF started on a 41–42° flank beside a 6 cm rim and both runs fell.
+        Session 16, 40° against off (``bench_littledog.py``'s runs, one
+        process each): large rocks seeds 0–7 4/8 at 5.56 cm/s (14 reflexes)
+        → 4/8 at 7.30 (7); seeds 8–15 5/8 at 5.47 → 5/8 at 7.23; logs seeds
+        0–5 4/6 at 7.52 → 4/6 at 7.22 (seed 1 lost, 5 gained); round rocks,
+        sloped rocks, gap, barrier, steps seeds 0–1 the same runs. Seeds 4
+        and 6 still fall: RF, moved 5 mm up the rock, slides off it. With
+        ``reflex.foot_position_m`` 0.02: large rocks 10/16 (9 without),
+        logs 4/6. Off by default: it buys speed, not yet success.
     """
 
     compute_time_scale: float = 1.0
@@ -649,11 +687,18 @@ class ExecutorConfig:
     plan_expansions: int = 0
     longest_step: float = 0.4
     start_snap_m: float = 0.015
+    start_max_slope: float = 0.5 * math.pi
 
     def __post_init__(self) -> None:
         _nonnegative(
             self,
-            ("compute_time_scale", "plan_expansions", "longest_step", "start_snap_m"),
+            (
+                "compute_time_scale",
+                "plan_expansions",
+                "longest_step",
+                "start_snap_m",
+                "start_max_slope",
+            ),
             "executor",
         )
         _positive(self, ("initial_plan_s",), "executor")

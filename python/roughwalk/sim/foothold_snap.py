@@ -38,16 +38,29 @@ def _foothold(
     return np.isfinite(cost) & np.asarray(terrain.is_known(xy), dtype=bool)
 
 
+def _on(cells: NDArray[np.bool_], terrain: Terrain, xy: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Whether the terrain cells nearest the points ``xy`` (n, 2) [m] are marked in ``cells``."""
+    nx, ny = terrain.shape
+    gi = np.clip(np.round((xy[:, 0] - terrain.x0) / terrain.dx), 0, nx - 1).astype(int)
+    gj = np.clip(np.round((xy[:, 1] - terrain.y0) / terrain.dy), 0, ny - 1).astype(int)
+    return np.asarray(cells[gi, gj], dtype=bool)
+
+
 def snap_to_footholds(
     planner: FootstepPlanner,
     terrain: Terrain,
     feet: NDArray[np.float64],
     radius: float,
+    refused: NDArray[np.bool_] | None = None,
 ) -> tuple[NDArray[np.float64], list[int]]:
     """Feet (4, 3) [m, canonical legs] with those off a foothold moved onto the nearest one.
 
     Only x and y change. A foot with no foothold within ``radius`` [m] stays
     (the planner will say why). Returns the feet and the legs moved.
+
+    ``refused``: terrain cells (nx, ny) no foot may stand on though the
+    planner allows them; a foot whose own centre is on one moves too, and
+    no foot moves onto one.
     """
     x0, y0, h, nx, ny = planner.lattice
     out = np.array(feet, dtype=float)
@@ -67,7 +80,11 @@ def snap_to_footholds(
             continue
         xy = np.array([x0, y0]) + h * cells
         ok = _foothold(planner, terrain, xy, front=leg < 2)
-        if ok[0] and np.all(cells[0] == cell):
+        here = True
+        if refused is not None:
+            ok &= ~_on(refused, terrain, xy)
+            here = not bool(_on(refused, terrain, out[leg : leg + 1, :2])[0])
+        if ok[0] and np.all(cells[0] == cell) and here:
             continue
         if not np.any(ok):
             continue

@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from roughwalk.errors import InvalidArgumentError
+from roughwalk.planning.foothold_safety import steep_footholds
 from roughwalk.robots.canonical_frame import LEG_NAMES
 from roughwalk.sim.config import ExecutorConfig
 from roughwalk.sim.foothold_snap import snap_to_footholds
@@ -246,6 +247,10 @@ class PlannerSource:
         How far [m] a foot of the nominal stance at a start pose that falls
         on no foothold may move onto the nearest one
         (:attr:`~roughwalk.sim.config.ExecutorConfig.start_snap_m`).
+    start_max_slope:
+        Steepest slope [rad] a start foot may stand on, where the footstep
+        settings allow steeper footholds
+        (:attr:`~roughwalk.sim.config.ExecutorConfig.start_max_slope`).
     options:
         Passed on to :class:`~roughwalk.planning.footstep_planner.FootstepPlanner`.
     """
@@ -258,6 +263,7 @@ class PlannerSource:
         terrain: Terrain,
         expansions: int | None = None,
         start_snap_m: float = ExecutorConfig.start_snap_m,
+        start_max_slope: float = ExecutorConfig.start_max_slope,
         **options: Any,
     ) -> None:
         from roughwalk.planning.footstep_planner import FootstepPlanner
@@ -266,6 +272,8 @@ class PlannerSource:
         self.terrain = terrain
         self.expansions = expansions
         self.start_snap_m = start_snap_m
+        self.start_max_slope = start_max_slope
+        self._steep_start: NDArray[np.bool_] | None = None
         self.planner = FootstepPlanner(robot, terrain, **options)
 
     def plan(self, start: PlanStart, goal: NDArray[np.float64], time_limit: float) -> PlanAttempt:
@@ -273,9 +281,11 @@ class PlannerSource:
         began = time.perf_counter()
         g = np.asarray(goal, dtype=float)[:2]
         if start.pose is not None:
-            result = self.planner.plan(
-                start.pose, g, time_limit=time_limit, expansions=self.expansions
-            )
+            result = self._plan_from_gentle_start(start.pose, g, time_limit)
+            if result is None:
+                result = self.planner.plan(
+                    start.pose, g, time_limit=time_limit, expansions=self.expansions
+                )
             if self.start_snap_m > 0 and result.start_off_foothold is not None:
                 # Put down with a foot on no foothold (a rock's rim): that foot
                 # goes onto the nearest foothold, the walk starts from there.
@@ -309,6 +319,36 @@ class PlannerSource:
             return PlanAttempt(None, result.status, reason, wall)
         start_clearance = None if result.initial_pose is None else result.initial_pose.clearance
         return PlanAttempt(result, result.status, "", wall, start_clearance)
+
+    def _plan_from_gentle_start(
+        self, pose: tuple[float, float, float], goal: NDArray[np.float64], time_limit: float
+    ) -> Any:
+        """A plan from the start stance with its feet on slopes beyond ``start_max_slope`` moved.
+
+        Each such foot goes onto the nearest foothold within ``start_snap_m``
+        no steeper than that (:func:`snap_to_footholds`), and the plan
+        starts from there. None where no foot moved (then the planner plans
+        from the pose as usual) or where either setting is off.
+        """
+        if self.start_snap_m <= 0 or self.start_max_slope >= 0.5 * math.pi:
+            return None
+        if self._steep_start is None:
+            self._steep_start = steep_footholds(
+                self.terrain, self.robot.foot_radius, self.start_max_slope
+            )
+        feet = self._stance_at(pose)
+        snapped, moved = snap_to_footholds(
+            self.planner, self.terrain, feet, self.start_snap_m, refused=self._steep_start
+        )
+        if not moved:
+            return None
+        return self.planner.replan(
+            snapped,
+            self.planner.config.walking_order[0],
+            goal=goal,
+            time_limit=time_limit,
+            expansions=self.expansions,
+        )
 
     def _stance_at(self, pose: tuple[float, float, float]) -> NDArray[np.float64]:
         """The nominal stance's feet (4, 3) [m] at the trunk pose (x, y, yaw), on the terrain."""

@@ -164,7 +164,11 @@ def run(
     for d in disturbances:
         seen = d.planner_terrain(seen)
     budget = cfg.executor.plan_expansions or None
-    options: dict[str, Any] = {"expansions": budget, "start_snap_m": cfg.executor.start_snap_m}
+    options: dict[str, Any] = {
+        "expansions": budget,
+        "start_snap_m": cfg.executor.start_snap_m,
+        "start_max_slope": cfg.executor.start_max_slope,
+    }
     options["config"] = planner_config(robot_obj, cfg.executor.longest_step, footstep)
     if isinstance(planner, str):
         if planner == "auto":
