@@ -369,6 +369,20 @@ class ReflexConfig:
         --set reflex.replan_budget_s=300``) walks every run as at 0.05, to
         the millisecond and reflex (none fires sooner or more often there),
         and the demo course stays at 5.64 cm/s.
+    foot_force_descent_m_s, foot_force_descent_n:
+        While the planned trunk descends faster than ``foot_force_descent_m_s``
+        [m/s], only a foot planned to bear at least ``foot_force_descent_n``
+        [N] (not ``foot_force_n``) is judged by its load. A planned descent
+        tilts the trunk and leaves a lightly planned foot light without any
+        tip: on the gap course (bench gap seed 1, ``--expansions 40000``)
+        the trunk lowers 5–7 cm as LF swings down to the trench floor
+        (0.14 m/s when the reflex fired), RH, planned to carry 3.3 N,
+        unloads, the trunk tilts 0.04–0.05 rad from its plan, and the
+        reflex fired though nothing was falling (off, that run walks on
+        without it). Raising ``foot_force_n`` to 4 N everywhere drops that
+        alarm but also the rescues on flat ground, where a side push
+        unloads a foot planned ~3 N with the trunk level (pushed right at
+        2.0 and 2.2 s). ``foot_force_descent_n`` = ``foot_force_n``: off.
     persist_s:
         An error must last this long [s] to count, so impact transients do not.
     settle_s:
@@ -511,6 +525,8 @@ class ReflexConfig:
     foot_force_fraction: float = 0.05
     foot_force_tilt_rad: float = 0.03
     foot_force_per_leg: bool = True
+    foot_force_descent_m_s: float = 0.05
+    foot_force_descent_n: float = 4.0
     persist_s: float = 0.03
     settle_s: float = 0.3
     settled_rate_rad_s: float = 0.2
@@ -545,6 +561,8 @@ class ReflexConfig:
             (
                 "foot_force_fraction",
                 "foot_force_tilt_rad",
+                "foot_force_descent_m_s",
+                "foot_force_descent_n",
                 "persist_s",
                 "settle_s",
                 "capture_max_m",
