@@ -378,11 +378,18 @@ class ReflexConfig:
         the trunk lowers 5–7 cm as LF swings down to the trench floor
         (0.14 m/s when the reflex fired), RH, planned to carry 3.3 N,
         unloads, the trunk tilts 0.04–0.05 rad from its plan, and the
-        reflex fired though nothing was falling (off, that run walks on
-        without it). Raising ``foot_force_n`` to 4 N everywhere drops that
+        reflex fired though nothing was falling (with ``foot_force_n`` 100
+        the run walks on). Raising ``foot_force_n`` to 4 N everywhere drops that
         alarm but also the rescues on flat ground, where a side push
         unloads a foot planned ~3 N with the trunk level (pushed right at
-        2.0 and 2.2 s). ``foot_force_descent_n`` = ``foot_force_n``: off.
+        2.0 and 2.2 s). With 0.05 m/s and 4 N (session 16, ``bench_littledog.py
+        --expansions 40000 --classes gap --seeds 6``) gap walks 6/6 at 7.18 →
+        7.33 cm/s (only seed 1 changes, 6.64 → 7.55, no reflex), and the 1 N·s
+        side pushes (``bench_push_recovery.py --from 1.6 --to 3.2``) survive
+        as before: 7/9 right, 8/9 left, the same push times. That descent
+        slows to 0.08 m/s while RH is still unloaded: at 0.1 m/s the alarm
+        fires at 8.14 s and seed 1 walks 6.64 cm/s, as on main.
+        ``foot_force_descent_n`` = ``foot_force_n``: off.
     persist_s:
         An error must last this long [s] to count, so impact transients do not.
     settle_s:
