@@ -411,8 +411,8 @@ def test_a_lightly_planned_foot_unloaded_by_a_planned_descent_is_no_tip(littledo
     --direction -90``) at 2.36-2.39 s: LF (planned 2.9 N) carries nothing
     with the trunk level in its plan, and the reflex is a rescue.
     """
-    cfg = ReflexConfig(persist_s=0.03)
-    off = ReflexConfig(persist_s=0.03, foot_force_descent_n=cfg.foot_force_n)
+    cfg = ReflexConfig(persist_s=0.03, foot_force_descent_m_s=0.05, foot_force_descent_n=4.0)
+    off = ReflexConfig(persist_s=0.03)  # the default: off
     trench = ((False, True, True, True), [0.0, 13.1, 10.7, 3.3], [0.0, 14.0, 11.3, 0.0])
     assert _lost_load_hits(littledog, off, *trench, 0.14)  # judged as before: it fires
     assert _lost_load_hits(littledog, cfg, *trench, 0.14) == []

@@ -388,8 +388,15 @@ class ReflexConfig:
         side pushes (``bench_push_recovery.py --from 1.6 --to 3.2``) survive
         as before: 7/9 right, 8/9 left, the same push times. That descent
         slows to 0.08 m/s while RH is still unloaded: at 0.1 m/s the alarm
-        fires at 8.14 s and seed 1 walks 6.64 cm/s, as on main.
-        ``foot_force_descent_n`` = ``foot_force_n``: off.
+        fires at 8.14 s and seed 1 walks 6.64 cm/s, as on main. Off by
+        default (``foot_force_descent_n`` 0, i.e. no more than
+        ``foot_force_n``): on board AE (bench large rocks seed 2) LF,
+        planned 2.3 N, unloads at 1.50 s as the planned trunk sinks
+        0.125 m/s, tilted 0.05 rad, and there the reflex (1.53 s) is a
+        rescue: with the condition at 0.05 m/s and 4 N it does not fire,
+        the robot walks on, a reflex fires at 2.96 s and the re-plan finds
+        no certificate (fails; 6.20 cm/s without the condition). The load,
+        descent rate and tilt there are those of the gap's false alarm.
     persist_s:
         An error must last this long [s] to count, so impact transients do not.
     settle_s:
@@ -533,7 +540,7 @@ class ReflexConfig:
     foot_force_tilt_rad: float = 0.03
     foot_force_per_leg: bool = True
     foot_force_descent_m_s: float = 0.05
-    foot_force_descent_n: float = 4.0
+    foot_force_descent_n: float = 0.0
     persist_s: float = 0.03
     settle_s: float = 0.3
     settled_rate_rad_s: float = 0.2

@@ -114,7 +114,7 @@ class ReflexMonitor:
         # A trunk lowered on purpose (a front foot reaching a trench floor)
         # tilts and leaves a lightly planned foot light: no sign of a tip.
         descending = self.planned_descent(desired, now) > cfg.foot_force_descent_m_s
-        least = cfg.foot_force_descent_n if descending else cfg.foot_force_n
+        least = max(cfg.foot_force_n, cfg.foot_force_descent_n) if descending else cfg.foot_force_n
         loaded = settled & (planned >= least) & determinate & tipping
         shortfall = np.where(loaded, planned - measured.foot_forces[:, 2], 0.0)
         limit = np.where(loaded, (1.0 - cfg.foot_force_fraction) * planned, np.inf)
