@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import mujoco
 import numpy as np
 import pytest
@@ -394,3 +396,55 @@ def test_a_supporting_foot_sliding_2_5_cm_fires_the_default_foot_position_reflex
         if trigger is not None:
             hits.append((k, trigger.kind, trigger.leg))
     assert hits and hits[0] == (55, "foot_position", "LF")  # 40 + 0.03 s / 0.002 s
+
+
+def _lost_load_hits(
+    littledog, config: ReflexConfig, in_contact, planned, carried, descent_m_s: float
+) -> list[int]:
+    """Ticks at which the foot-force reflex fires for a foot that carries less than planned.
+
+    ``planned`` and ``carried`` (4,): vertical loads [N]; the planned trunk
+    sinks at ``descent_m_s`` [m/s], the measured one follows it tilted 0.045 rad.
+    """
+    monitor = ReflexMonitor(config)
+    standing = standing_step(littledog, in_contact=in_contact)
+    forces = standing.forces.copy()
+    forces[:, 2] = planned
+    measured = type("M", (), {})()
+    measured.feet = standing.feet.copy()
+    tilt = 0.045  # beyond foot_force_tilt_rad
+    measured.base_quat = np.array([np.cos(tilt / 2), 0.0, np.sin(tilt / 2), 0.0])
+    measured.foot_forces = forces.copy()
+    measured.foot_forces[:, 2] = carried
+    hits = []
+    for k in range(60):
+        measured.time = 0.002 * k
+        base = standing.base_pos - np.array([0.0, 0.0, descent_m_s * measured.time])
+        desired = dataclasses.replace(standing, base_pos=base, forces=forces)
+        measured.base_pos = base.copy()
+        trigger = monitor.check(desired, measured)
+        if trigger is not None and trigger.kind == "foot_force":
+            hits.append(k)
+    return hits
+
+
+def test_a_lightly_planned_foot_unloaded_by_a_planned_descent_is_no_tip(littledog) -> None:
+    """``reflex.foot_force_descent_m_s`` / ``foot_force_descent_n``: recorded loads.
+
+    Bench gap seed 1 (``--expansions 40000``) at 7.95-7.98 s: LF swings down
+    to the trench floor, the planned trunk sinks 0.14 m/s, RH (planned 3.3 N)
+    carries nothing and the trunk is 0.04-0.05 rad off its plan: a false
+    alarm. Pushed right at 2.0 s on flat ground (``bench_push_recovery.py
+    --direction -90``) at 2.36-2.39 s: LF (planned 2.9 N) carries nothing
+    with the trunk level in its plan, and the reflex is a rescue.
+    """
+    cfg = ReflexConfig(persist_s=0.03, foot_force_descent_m_s=0.05, foot_force_descent_n=4.0)
+    off = ReflexConfig(persist_s=0.03)  # the default: off
+    trench = ((False, True, True, True), [0.0, 13.1, 10.7, 3.3], [0.0, 14.0, 11.3, 0.0])
+    assert _lost_load_hits(littledog, off, *trench, 0.14)  # judged as before: it fires
+    assert _lost_load_hits(littledog, cfg, *trench, 0.14) == []
+    pushed = ((True, True, True, False), [2.9, 13.1, 10.4, 0.0], [0.0, 20.3, 6.1, 0.0])
+    assert _lost_load_hits(littledog, cfg, *pushed, 0.0)[0] == 45  # settled at 30, + 0.03 s
+    # A descent does not hide a foot planned to carry a real share.
+    heavy = ((False, True, True, True), [0.0, 10.0, 6.0, 10.0], [0.0, 12.0, 8.0, 0.0])
+    assert _lost_load_hits(littledog, cfg, *heavy, 0.14)

@@ -389,6 +389,34 @@ class ReflexConfig:
         --set reflex.replan_budget_s=300``) walks every run as at 0.05, to
         the millisecond and reflex (none fires sooner or more often there),
         and the demo course stays at 5.64 cm/s.
+    foot_force_descent_m_s, foot_force_descent_n:
+        While the planned trunk descends faster than ``foot_force_descent_m_s``
+        [m/s], only a foot planned to bear at least ``foot_force_descent_n``
+        [N] (not ``foot_force_n``) is judged by its load. A planned descent
+        tilts the trunk and leaves a lightly planned foot light without any
+        tip: on the gap course (bench gap seed 1, ``--expansions 40000``)
+        the trunk lowers 5–7 cm as LF swings down to the trench floor
+        (0.14 m/s when the reflex fired), RH, planned to carry 3.3 N,
+        unloads, the trunk tilts 0.04–0.05 rad from its plan, and the
+        reflex fired though nothing was falling (with ``foot_force_n`` 100
+        the run walks on). Raising ``foot_force_n`` to 4 N everywhere drops that
+        alarm but also the rescues on flat ground, where a side push
+        unloads a foot planned ~3 N with the trunk level (pushed right at
+        2.0 and 2.2 s). With 0.05 m/s and 4 N (session 16, ``bench_littledog.py
+        --expansions 40000 --classes gap --seeds 6``) gap walks 6/6 at 7.18 →
+        7.33 cm/s (only seed 1 changes, 6.64 → 7.55, no reflex), and the 1 N·s
+        side pushes (``bench_push_recovery.py --from 1.6 --to 3.2``) survive
+        as before: 7/9 right, 8/9 left, the same push times. That descent
+        slows to 0.08 m/s while RH is still unloaded: at 0.1 m/s the alarm
+        fires at 8.14 s and seed 1 walks 6.64 cm/s, as on main. Off by
+        default (``foot_force_descent_n`` 0, i.e. no more than
+        ``foot_force_n``): on board AE (bench large rocks seed 2) LF,
+        planned 2.3 N, unloads at 1.50 s as the planned trunk sinks
+        0.125 m/s, tilted 0.05 rad, and there the reflex (1.53 s) is a
+        rescue: with the condition at 0.05 m/s and 4 N it does not fire,
+        the robot walks on, a reflex fires at 2.96 s and the re-plan finds
+        no certificate (fails; 6.20 cm/s without the condition). The load,
+        descent rate and tilt there are those of the gap's false alarm.
     persist_s:
         An error must last this long [s] to count, so impact transients do not.
     settle_s:
@@ -531,6 +559,8 @@ class ReflexConfig:
     foot_force_fraction: float = 0.05
     foot_force_tilt_rad: float = 0.03
     foot_force_per_leg: bool = True
+    foot_force_descent_m_s: float = 0.05
+    foot_force_descent_n: float = 0.0
     persist_s: float = 0.03
     settle_s: float = 0.3
     settled_rate_rad_s: float = 0.2
@@ -565,6 +595,8 @@ class ReflexConfig:
             (
                 "foot_force_fraction",
                 "foot_force_tilt_rad",
+                "foot_force_descent_m_s",
+                "foot_force_descent_n",
                 "persist_s",
                 "settle_s",
                 "capture_max_m",

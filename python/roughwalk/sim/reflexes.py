@@ -65,12 +65,22 @@ class ReflexMonitor:
         self._since: dict[str, float | None] = dict.fromkeys(_KINDS)
         self._down_since = np.full(4, np.inf)
         self._short_leg: str | None = None
+        self._last_desired_z: tuple[float, float] | None = None  # (time [s], trunk height [m])
 
     def reset(self) -> None:
         """Forget persisting errors (after a reflex, or when a new plan starts)."""
         self._since = dict.fromkeys(_KINDS)
         self._down_since[:] = np.inf
         self._short_leg = None
+        self._last_desired_z = None
+
+    def planned_descent(self, desired: DesiredState, now: float) -> float:
+        """The planned trunk's descent rate [m/s] since the last tick (0 on the first one)."""
+        z = float(desired.base_pos[2])
+        last, self._last_desired_z = self._last_desired_z, (now, z)
+        if last is None or not 0.0 < now - last[0] <= 0.02:
+            return 0.0
+        return (last[1] - z) / (now - last[0])
 
     def errors(
         self, desired: DesiredState, measured: MeasuredState
@@ -101,7 +111,11 @@ class ReflexMonitor:
         # With three, a planned load the foot does not carry means tipping.
         determinate = bool(np.sum(down) == 3)
         tipping = tilt > cfg.foot_force_tilt_rad
-        loaded = settled & (planned >= cfg.foot_force_n) & determinate & tipping
+        # A trunk lowered on purpose (a front foot reaching a trench floor)
+        # tilts and leaves a lightly planned foot light: no sign of a tip.
+        descending = self.planned_descent(desired, now) > cfg.foot_force_descent_m_s
+        least = max(cfg.foot_force_n, cfg.foot_force_descent_n) if descending else cfg.foot_force_n
+        loaded = settled & (planned >= least) & determinate & tipping
         shortfall = np.where(loaded, planned - measured.foot_forces[:, 2], 0.0)
         limit = np.where(loaded, (1.0 - cfg.foot_force_fraction) * planned, np.inf)
         ratio = shortfall / limit
