@@ -416,7 +416,21 @@ class ReflexConfig:
         rescue: with the condition at 0.05 m/s and 4 N it does not fire,
         the robot walks on, a reflex fires at 2.96 s and the re-plan finds
         no certificate (fails; 6.20 cm/s without the condition). The load,
-        descent rate and tilt there are those of the gap's false alarm.
+        descent rate and tilt there are those of the gap's false alarm; the
+        centre of mass is not (``foot_force_descent_lean_m``).
+    foot_force_descent_lean_m:
+        The descent's exemption holds for a light foot only while the
+        measured centre of mass leans at least this far [m] onto it: past
+        the line through the two other supporting feet, on its side
+        (:func:`~roughwalk.sim.reflexes.lean_toward`). Leaning onto a foot
+        presses it down (it bears again when it touches); a robot balanced
+        on the other two, or leaning away, tips off it. Recorded in the two
+        runs (``bench_littledog.py --expansions 40000``, session 17): gap
+        seed 1's false alarm (7.90–7.98 s, RH light, planned 3.3 N, the
+        trunk sinking 0.14 m/s) leaned 0.8–1.3 cm onto RH; large rocks
+        seed 2's rescue (1.45–1.52 s, LF planned 2.1–2.4 N, on a rock face:
+        its contact force mostly sideways, sinking 0.10–0.13 m/s) 0.1–0.2
+        cm. A negative value asks for no lean (the exemption of session 16).
     persist_s:
         An error must last this long [s] to count, so impact transients do not.
     settle_s:
@@ -561,6 +575,7 @@ class ReflexConfig:
     foot_force_per_leg: bool = True
     foot_force_descent_m_s: float = 0.05
     foot_force_descent_n: float = 0.0
+    foot_force_descent_lean_m: float = 0.005
     persist_s: float = 0.03
     settle_s: float = 0.3
     settled_rate_rad_s: float = 0.2
