@@ -727,6 +727,14 @@ class ExecutorConfig:
         and 6 still fall: RF, moved 5 mm up the rock, slides off it. With
         ``reflex.foot_position_m`` 0.02: large rocks 10/16 (9 without),
         logs 4/6. Off by default: it buys speed, not yet success.
+    refuse_colliding_m:
+        When the trajectory generator returns the next footstep colliding
+        (its report not collision-free: no timing it tried keeps the legs
+        off the terrain), the executor does not walk it: it re-plans from
+        the stance the current footstep ends in, with that foothold and
+        everything within this radius [m] of it refused to the leg's end
+        (``PlanStart.refused``), and blends into the new plan's first
+        footstep. 0: the step is walked as it came.
     """
 
     compute_time_scale: float = 1.0
@@ -735,11 +743,13 @@ class ExecutorConfig:
     longest_step: float = 0.4
     start_snap_m: float = 0.015
     start_max_slope: float = 0.5 * math.pi
+    refuse_colliding_m: float = 0.0
 
     def __post_init__(self) -> None:
         _nonnegative(
             self,
             (
+                "refuse_colliding_m",
                 "compute_time_scale",
                 "plan_expansions",
                 "longest_step",
