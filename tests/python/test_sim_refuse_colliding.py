@@ -20,7 +20,7 @@ from roughwalk.sim.footstep_source import PlanAttempt, PlannerSource, PlanStart
 from roughwalk.sim.trajectory_buffer import Segment
 
 HAVE_PLANNER = hasattr(_core, "FootstepPlanner")
-GOAL = np.array([0.9, 0.0])
+GOAL = np.array([0.55, 0.0])
 
 
 class RecordingCrawl:
@@ -73,6 +73,7 @@ def test_a_colliding_footstep_is_walked_as_it_came_when_off() -> None:
 
 
 def test_a_colliding_footstep_is_replanned_from_the_stance_before_it_with_its_foothold_refused():
+    assert SimConfig().executor.refuse_colliding_m == 0.03  # the default since session 17
     executor, source, plan, first = _schedule_after_first(0.03)
     assert len(source.starts) == 2
     start = source.starts[-1]

@@ -445,7 +445,7 @@ def test_a_lightly_planned_foot_unloaded_by_a_planned_descent_is_no_tip(littledo
         foot_force_descent_n=4.0,
         foot_force_descent_lean_m=-1.0,  # whatever the lean: the planned loads alone
     )
-    off = ReflexConfig(persist_s=0.03)  # the default: off
+    off = ReflexConfig(persist_s=0.03, foot_force_descent_n=0.0)  # off
     trench = ((False, True, True, True), [0.0, 13.1, 10.7, 3.3], [0.0, 14.0, 11.3, 0.0])
     assert _lost_load_hits(littledog, off, *trench, 0.14)  # judged as before: it fires
     assert _lost_load_hits(littledog, cfg, *trench, 0.14) == []
@@ -543,11 +543,12 @@ def test_the_descent_exemption_needs_the_robot_to_lean_onto_the_light_foot(littl
     assert lean[3] == pytest.approx(0.0089, abs=5e-4)
     lean = lean_toward(np.array(rocks["com"]), np.array(rocks["feet"]), np.array(rocks["support"]))
     assert lean[0] == pytest.approx(0.0011, abs=5e-4)
-    default = ReflexConfig(persist_s=0.03)  # no exemption: both fire
-    assert _recorded_load_hits(littledog, default, gap)[0] == 45  # settled at 30, + 0.03 s
-    assert _recorded_load_hits(littledog, default, rocks)[0] == 45
+    off = ReflexConfig(persist_s=0.03, foot_force_descent_n=0.0)  # no exemption: both fire
+    assert _recorded_load_hits(littledog, off, gap)[0] == 45  # settled at 30, + 0.03 s
+    assert _recorded_load_hits(littledog, off, rocks)[0] == 45
     exempt = dict(persist_s=0.03, foot_force_descent_m_s=0.05, foot_force_descent_n=4.0)
     leaning = ReflexConfig(**exempt)  # the lean asked by default: 0.5 cm
+    assert ReflexConfig().foot_force_descent_n == 4.0  # the default since session 17
     assert _recorded_load_hits(littledog, leaning, gap) == []
     assert _recorded_load_hits(littledog, leaning, rocks)[0] == 45
     any_lean = ReflexConfig(**exempt, foot_force_descent_lean_m=-1.0)  # session 16's exemption
