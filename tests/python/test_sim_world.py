@@ -16,7 +16,7 @@ from roughwalk.sim.config import IntegratorConfig, ReflexConfig, WorldConfig
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
 from roughwalk.sim.recovery import hold_segment, pose_segment
-from roughwalk.sim.reflexes import ReflexMonitor
+from roughwalk.sim.reflexes import ReflexMonitor, lean_toward
 from roughwalk.sim.runner import Runner, ServoCommand
 from roughwalk.sim.trajectory_buffer import Segment, TrajectoryBuffer
 from roughwalk.sim.world import World
@@ -422,6 +422,7 @@ def _lost_load_hits(
         base = standing.base_pos - np.array([0.0, 0.0, descent_m_s * measured.time])
         desired = dataclasses.replace(standing, base_pos=base, forces=forces)
         measured.base_pos = base.copy()
+        measured.com = base.copy()
         trigger = monitor.check(desired, measured)
         if trigger is not None and trigger.kind == "foot_force":
             hits.append(k)
@@ -438,8 +439,13 @@ def test_a_lightly_planned_foot_unloaded_by_a_planned_descent_is_no_tip(littledo
     --direction -90``) at 2.36-2.39 s: LF (planned 2.9 N) carries nothing
     with the trunk level in its plan, and the reflex is a rescue.
     """
-    cfg = ReflexConfig(persist_s=0.03, foot_force_descent_m_s=0.05, foot_force_descent_n=4.0)
-    off = ReflexConfig(persist_s=0.03)  # the default: off
+    cfg = ReflexConfig(
+        persist_s=0.03,
+        foot_force_descent_m_s=0.05,
+        foot_force_descent_n=4.0,
+        foot_force_descent_lean_m=-1.0,  # whatever the lean: the planned loads alone
+    )
+    off = ReflexConfig(persist_s=0.03, foot_force_descent_n=0.0)  # off
     trench = ((False, True, True, True), [0.0, 13.1, 10.7, 3.3], [0.0, 14.0, 11.3, 0.0])
     assert _lost_load_hits(littledog, off, *trench, 0.14)  # judged as before: it fires
     assert _lost_load_hits(littledog, cfg, *trench, 0.14) == []
@@ -448,3 +454,102 @@ def test_a_lightly_planned_foot_unloaded_by_a_planned_descent_is_no_tip(littledo
     # A descent does not hide a foot planned to carry a real share.
     heavy = ((False, True, True, True), [0.0, 10.0, 6.0, 10.0], [0.0, 12.0, 8.0, 0.0])
     assert _lost_load_hits(littledog, cfg, *heavy, 0.14)
+
+
+# Recorded ticks (``bench_littledog.py --expansions 40000``, session 17): the
+# planned support, planned and carried vertical loads [N], measured and planned
+# feet [m], the measured centre of mass [m] and the planned trunk's descent [m/s].
+_GAP_1_RH_LIGHT = {  # gap seed 1 at 7.976 s: LF swings down to the trench floor
+    "support": (False, True, True, True),
+    "planned": [0.0, 13.27, 10.74, 3.29],
+    "carried": [0.0, 15.28, 13.05, 0.0],
+    "feet": [
+        [0.9961, 0.0515, -0.0067],
+        [0.8983, -0.0689, 0.0102],
+        [0.8165, 0.0634, 0.0102],
+        [0.7591, -0.0347, 0.0107],
+    ],
+    "feet_desired": [
+        [0.9933, 0.0535, 0.0001],
+        [0.8939, -0.0677, 0.0103],
+        [0.8080, 0.0636, 0.0103],
+        [0.7575, -0.0323, 0.0103],
+    ],
+    "com": [0.8510, -0.0087, 0.1211],
+    "descent": 0.138,
+}
+_LARGE_ROCKS_2_LF_LIGHT = {  # board AE, large rocks seed 2 at 1.520 s: RH swings
+    "support": (True, True, True, False),
+    "planned": [2.37, 14.98, 8.87, 0.0],
+    "carried": [0.0, 17.25, 10.29, 0.0],
+    "feet": [
+        [0.3435, 0.3373, 0.0971],
+        [0.2589, 0.2566, 0.1005],
+        [0.1321, 0.3567, 0.0855],
+        [0.1365, 0.2260, 0.1218],
+    ],
+    "feet_desired": [
+        [0.3429, 0.3354, 0.0959],
+        [0.2545, 0.2563, 0.0999],
+        [0.1288, 0.3574, 0.0863],
+        [0.1353, 0.2277, 0.1269],
+    ],
+    "com": [0.2161, 0.2920, 0.2243],
+    "descent": 0.126,
+}
+
+
+def _recorded_load_hits(littledog, config: ReflexConfig, recorded: dict) -> list[int]:
+    """Ticks at which the foot-force reflex fires on a recorded tick held still.
+
+    The trunk sinks as recorded, the measured one tilted 0.045 rad from its plan.
+    """
+    monitor = ReflexMonitor(config)
+    standing = standing_step(littledog, in_contact=recorded["support"])
+    forces = np.zeros((4, 3))
+    forces[:, 2] = recorded["planned"]
+    measured = type("M", (), {})()
+    measured.feet = np.array(recorded["feet"])
+    measured.com = np.array(recorded["com"])
+    tilt = 0.045  # beyond foot_force_tilt_rad
+    measured.base_quat = np.array([np.cos(tilt / 2), 0.0, np.sin(tilt / 2), 0.0])
+    measured.foot_forces = np.zeros((4, 3))
+    measured.foot_forces[:, 2] = recorded["carried"]
+    hits = []
+    for k in range(60):
+        measured.time = 0.002 * k
+        base = standing.base_pos - np.array([0.0, 0.0, recorded["descent"] * measured.time])
+        desired = dataclasses.replace(
+            standing, base_pos=base, forces=forces, feet=np.array(recorded["feet_desired"])
+        )
+        measured.base_pos = base.copy()
+        trigger = monitor.check(desired, measured)
+        if trigger is not None and trigger.kind == "foot_force":
+            hits.append(k)
+    return hits
+
+
+def test_the_descent_exemption_needs_the_robot_to_lean_onto_the_light_foot(littledog) -> None:
+    """``reflex.foot_force_descent_lean_m``: recorded loads and centre of mass.
+
+    Gap seed 1's false alarm: RH light while the trunk sinks towards the
+    trench, the centre of mass 0.9 cm past the RF–LH line on RH's side.
+    Large rocks seed 2's rescue: LF light on a rock face while the trunk
+    sinks as fast, the centre of mass on the RF–LH line (0.1 cm): the
+    session-16 exemption (no lean asked) hid it as well.
+    """
+    gap, rocks = _GAP_1_RH_LIGHT, _LARGE_ROCKS_2_LF_LIGHT
+    lean = lean_toward(np.array(gap["com"]), np.array(gap["feet"]), np.array(gap["support"]))
+    assert lean[3] == pytest.approx(0.0089, abs=5e-4)
+    lean = lean_toward(np.array(rocks["com"]), np.array(rocks["feet"]), np.array(rocks["support"]))
+    assert lean[0] == pytest.approx(0.0011, abs=5e-4)
+    off = ReflexConfig(persist_s=0.03, foot_force_descent_n=0.0)  # no exemption: both fire
+    assert _recorded_load_hits(littledog, off, gap)[0] == 45  # settled at 30, + 0.03 s
+    assert _recorded_load_hits(littledog, off, rocks)[0] == 45
+    exempt = dict(persist_s=0.03, foot_force_descent_m_s=0.05, foot_force_descent_n=4.0)
+    leaning = ReflexConfig(**exempt)  # the lean asked by default: 0.5 cm
+    assert ReflexConfig().foot_force_descent_n == 4.0  # the default since session 17
+    assert _recorded_load_hits(littledog, leaning, gap) == []
+    assert _recorded_load_hits(littledog, leaning, rocks)[0] == 45
+    any_lean = ReflexConfig(**exempt, foot_force_descent_lean_m=-1.0)  # session 16's exemption
+    assert _recorded_load_hits(littledog, any_lean, rocks) == []

@@ -62,6 +62,11 @@ class FootstepPlanner:
     sdf:
         A prebuilt signed distance field of ``terrain`` to reuse; built at
         ``config.sdf_resolution`` if None.
+    refused:
+        (front, hind) boolean masks of the terrain's cells (nx, ny) that are
+        no footholds for the front or the hind legs, on top of the
+        config's checks: footholds an execution found unwalkable
+        (:meth:`with_refused`).
 
     """
 
@@ -72,6 +77,7 @@ class FootstepPlanner:
         config: FootstepConfig | None = None,
         cost: FootholdCost | None = None,
         sdf: SignedDistanceField | None = None,
+        refused: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
         self.robot = robot
         self.terrain = terrain
@@ -120,6 +126,15 @@ class FootstepPlanner:
                     self.cost_front = np.where(at_wall, np.inf, self.cost_front)
                 else:
                     self.cost_hind = np.where(at_wall, np.inf, self.cost_hind)
+        if refused is not None:
+            front, hind = (np.asarray(m, dtype=bool) for m in refused)
+            if front.shape != self.cost_front.shape or hind.shape != self.cost_hind.shape:
+                raise InvalidArgumentError(
+                    f"refused masks must have the terrain's shape {self.cost_front.shape}, "
+                    f"got {front.shape} and {hind.shape}"
+                )
+            self.cost_front = np.where(front, np.inf, self.cost_front)
+            self.cost_hind = np.where(hind, np.inf, self.cost_hind)
         t2 = time.perf_counter()
         collision = CollisionModel.from_robot(robot)
         body = ~collision.is_foot
@@ -147,6 +162,29 @@ class FootstepPlanner:
         t3 = time.perf_counter()
         self.precompute_s = {"sdf": t1 - t0, "cost_map": t2 - t1, "model": t3 - t2}
         self._goal: tuple[float, float] | None = None
+
+    def refused_masks(self, leg: int, x: float, y: float, radius: float) -> tuple[Any, Any]:
+        """(front, hind) masks of the terrain's cells within ``radius`` [m] of (x, y) [m].
+
+        Only the end of ``leg`` (canonical index, 0–3: LF, RF, LH, RH) gets the
+        disc; the other mask is empty. For ``refused``.
+        """
+        t = self.terrain
+        xs, ys = np.meshgrid(
+            np.asarray(t.x, dtype=float), np.asarray(t.y, dtype=float), indexing="ij"
+        )
+        disc = (xs - x) ** 2 + (ys - y) ** 2 <= radius**2
+        empty = np.zeros_like(disc)
+        return (disc, empty) if LEGS[int(leg)].endswith("F") else (empty, disc)
+
+    def with_refused(self, refused: tuple[Any, Any]) -> FootstepPlanner:
+        """A planner like this one, with the (front, hind) masks ``refused`` as no footholds.
+
+        The signed distance field is shared; the certificate cache starts anew.
+        """
+        return FootstepPlanner(
+            self.robot, self.terrain, self.config, self.cost, self.sdf, refused=refused
+        )
 
     @property
     def lattice(self) -> tuple[float, float, float, int, int]:

@@ -408,15 +408,38 @@ class ReflexConfig:
         side pushes (``bench_push_recovery.py --from 1.6 --to 3.2``) survive
         as before: 7/9 right, 8/9 left, the same push times. That descent
         slows to 0.08 m/s while RH is still unloaded: at 0.1 m/s the alarm
-        fires at 8.14 s and seed 1 walks 6.64 cm/s, as on main. Off by
-        default (``foot_force_descent_n`` 0, i.e. no more than
-        ``foot_force_n``): on board AE (bench large rocks seed 2) LF,
+        fires at 8.14 s and seed 1 walks 6.64 cm/s, as on main. It was
+        off in session 16 (``foot_force_descent_n`` 0, i.e. no more than
+        ``foot_force_n``; 0 still turns it off): on board AE (bench large rocks seed 2) LF,
         planned 2.3 N, unloads at 1.50 s as the planned trunk sinks
         0.125 m/s, tilted 0.05 rad, and there the reflex (1.53 s) is a
         rescue: with the condition at 0.05 m/s and 4 N it does not fire,
         the robot walks on, a reflex fires at 2.96 s and the re-plan finds
         no certificate (fails; 6.20 cm/s without the condition). The load,
-        descent rate and tilt there are those of the gap's false alarm.
+        descent rate and tilt there are those of the gap's false alarm; the
+        centre of mass is not (``foot_force_descent_lean_m``). With that
+        lean asked, 4 N by default since session 17 (``bench_littledog.py
+        --expansions 40000 --seeds 6 --jobs 1``, main and the branch back to
+        back): gap 6/6 at 7.18 → 7.33 cm/s (seed 1 6.64 → 7.55, no reflex),
+        large rocks 5/6 at 5.30 and logs 4/6 at 7.71, every run at the same
+        speed (logs seed 2 still rolls over, after 3 reflexes, not 2);
+        round rocks, sloped rocks, barrier, steps (``--seeds 2``) the same
+        runs. Without the lean, large rocks seed 2 walked 6.20 → 3.14 cm/s.
+    foot_force_descent_lean_m:
+        The descent's exemption holds for a light foot only while the
+        measured centre of mass leans at least this far [m] onto it: past
+        the line through the two other supporting feet, on its side
+        (:func:`~roughwalk.sim.reflexes.lean_toward`). Leaning onto a foot
+        presses it down (it bears again when it touches); a robot balanced
+        on the other two, or leaning away, tips off it. Recorded in the two
+        runs (``bench_littledog.py --expansions 40000``, session 17): gap
+        seed 1's false alarm (7.90–7.98 s, RH light, planned 3.3 N, the
+        trunk sinking 0.14 m/s) leaned 0.8–1.3 cm onto RH; large rocks
+        seed 2's rescue (1.45–1.52 s, LF planned 2.1–2.4 N, on a rock face:
+        its contact force mostly sideways, sinking 0.10–0.13 m/s) 0.1–0.2
+        cm. A negative value asks for no lean (the exemption of session 16).
+        The 1 N·s side pushes keep their rescues: their trunk is planned
+        level, so no exemption applies (as measured with session 16's).
     persist_s:
         An error must last this long [s] to count, so impact transients do not.
     settle_s:
@@ -560,7 +583,8 @@ class ReflexConfig:
     foot_force_tilt_rad: float = 0.03
     foot_force_per_leg: bool = True
     foot_force_descent_m_s: float = 0.05
-    foot_force_descent_n: float = 0.0
+    foot_force_descent_n: float = 4.0
+    foot_force_descent_lean_m: float = 0.005
     persist_s: float = 0.03
     settle_s: float = 0.3
     settled_rate_rad_s: float = 0.2
@@ -712,6 +736,28 @@ class ExecutorConfig:
         and 6 still fall: RF, moved 5 mm up the rock, slides off it. With
         ``reflex.foot_position_m`` 0.02: large rocks 10/16 (9 without),
         logs 4/6. Off by default: it buys speed, not yet success.
+    refuse_colliding_m:
+        When the trajectory generator returns the next footstep colliding
+        (its report not collision-free: no timing it tried keeps the legs
+        off the terrain), the executor does not walk it: it re-plans from
+        the stance the current footstep ends in, with that foothold and
+        everything within this radius [m] of it refused to the leg's end
+        (``PlanStart.refused``), and blends into the new plan's first
+        footstep. 0: the step is walked as it came. On the gap (bench
+        seed 0, ``--expansions 40000``) RF's step onto the trench floor 3
+        cm past the near wall had its shank 1.6 cm inside the rim at
+        touchdown; walked, the shank rested on the rim and a foot-force
+        reflex cost 1.1 s (6.51 cm/s); with 3 cm refused the re-planned step
+        is valid (7.64 cm/s). 0.03 by default since session 17
+        (``bench_littledog.py --expansions 40000 --seeds 6 --jobs 1`` with
+        ``reflex.foot_force_descent_n`` 4, main and the branch back to
+        back): gap 6/6 at 7.33 → 7.52 cm/s, logs and large rocks every run
+        the same, round rocks, sloped rocks, barrier, steps (``--seeds 2``)
+        the same runs. The re-plan starts a planner with the refused cells
+        and a cold certificate cache: where computing is charged
+        (``compute_time_scale``) the robot waits for it at the end of the
+        current footstep, up to ``reflex.replan_budget_s`` and the rebuild
+        (~0.5 s).
     """
 
     compute_time_scale: float = 1.0
@@ -720,11 +766,13 @@ class ExecutorConfig:
     longest_step: float = 0.4
     start_snap_m: float = 0.015
     start_max_slope: float = 0.5 * math.pi
+    refuse_colliding_m: float = 0.03
 
     def __post_init__(self) -> None:
         _nonnegative(
             self,
             (
+                "refuse_colliding_m",
                 "compute_time_scale",
                 "plan_expansions",
                 "longest_step",

@@ -186,6 +186,7 @@ class Executor:
         self._leg_joints = np.asarray(robot.canonical_index).reshape(4, 3)
         # When the recovery's hold stops waiting for the robot to settle [s].
         self._settle_deadline: float | None = None
+        self._goal = np.zeros(2)
 
     # ---- planning -------------------------------------------------------------------
 
@@ -233,6 +234,7 @@ class Executor:
         """Walk from the trunk pose ``start`` (x [m], y [m], yaw [rad]) to ``goal`` (x, y) [m]."""
         cfg = self.config
         goal_xy = np.asarray(goal, dtype=float)[:2]
+        self._goal = goal_xy
         log = self.log
         log.meta.update(
             robot=self.robot.name,
@@ -448,6 +450,12 @@ class Executor:
         traj, wall = self._next_step(plan)
         if traj is None:
             return
+        if (
+            self.config.executor.refuse_colliding_m > 0
+            and not traj.report.collision_free
+            and self._replan_around(traj, now, wall)
+        ):
+            return
         ready = now + self._charge(wall)
         self.buffer.append(Segment.from_footstep(traj, ready_at=ready))
         self.log.event(
@@ -460,6 +468,49 @@ class Executor:
             attempts=int(traj.report.attempts),
             duration_s=float(traj.report.duration_s),
         )
+
+    def _replan_around(self, colliding: FootstepTrajectory, now: float, wall: float) -> bool:
+        """Re-plan instead of walking a footstep the generator could not make collision-free.
+
+        From the stance the current footstep ends in, with the colliding
+        step's foothold refused within ``executor.refuse_colliding_m``
+        (§6's re-planning, before the error rather than after it: on the
+        gap, RF's shank came to rest on the trench's rim and a reflex cost
+        1.1 s). The new plan's first footstep follows the current one
+        after a blend. Returns whether a plan came; if not, the step is
+        walked as it is. Its wall time, ``wall`` [s] before it, is charged.
+        """
+        current = self.buffer.current
+        if current is None or current.kind != "step":
+            return False
+        end = current.last()
+        leg = LEG_NAMES.index(colliding.leg)
+        x, y = (float(v) for v in colliding.feet[-1, leg, :2])
+        radius = self.config.executor.refuse_colliding_m
+        start = PlanStart(feet=end.feet.copy(), next_leg=leg, refused=((leg, x, y, radius),))
+        budget = self.config.reflex.replan_budget_s
+        plan, attempt, plan_wall = self._make_plan(start, self._goal, budget)
+        first, step_wall = self._next_step(plan) if plan is not None else (None, 0.0)
+        wall += plan_wall + step_wall
+        self.log.event(
+            now,
+            "refused",
+            step=int(colliding.step),
+            leg=colliding.leg,
+            foothold=[x, y],
+            status=attempt.status,
+            wall_s=wall,
+            reason=attempt.reason if plan is None else "",
+            valid=bool(first.valid) if first is not None else None,
+        )
+        if plan is None or first is None:
+            return False
+        self._plan = plan
+        ready = now + self._charge(wall)
+        segment = Segment.from_footstep(first, ready_at=ready)
+        self.buffer.append(blend_segment(self.robot, end, segment.sample(0.0), 0.2, ready))
+        self.buffer.append(segment)
+        return True
 
     def _next_leg(self, desired: DesiredState) -> int | None:
         """The leg to move first after a reflex: the swing leg if not yet landed, else the next."""

@@ -66,12 +66,17 @@ class PlanStart:
     with ``next_leg`` (canonical index) the leg to move first and optionally
     ``trunk``, the measured trunk position (3,) [m] and quaternion (4,)
     (w, x, y, z) that the start certificate may be searched from.
+    ``refused`` lists footholds no plan may step on again, as (canonical
+    leg, x [m], y [m], radius [m]): the leg's end (front or hind) keeps out
+    of that disc (a step there the trajectory generator could not make
+    collision-free).
     """
 
     pose: tuple[float, float, float] | None = None
     feet: NDArray[np.float64] | None = None
     next_leg: int | None = None
     trunk: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+    refused: tuple[tuple[int, float, float, float], ...] = ()
 
     def __post_init__(self) -> None:
         if (self.pose is None) == (self.feet is None):
@@ -275,6 +280,8 @@ class PlannerSource:
         self.start_max_slope = start_max_slope
         self._steep_start: NDArray[np.bool_] | None = None
         self.planner = FootstepPlanner(robot, terrain, **options)
+        self._refused: list[tuple[int, float, float, float]] = []
+        self._refusing_planner: Any = None
 
     def plan(self, start: PlanStart, goal: NDArray[np.float64], time_limit: float) -> PlanAttempt:
         """Plan within ``time_limit`` [s]; the best plan found by then is returned."""
@@ -304,8 +311,9 @@ class PlannerSource:
         else:
             assert start.feet is not None
             leg = LEG_NAMES[start.next_leg] if start.next_leg is not None else "LH"
-            feet, _ = snap_to_footholds(self.planner, self.terrain, start.feet, SNAP_RADIUS_M)
-            result = self.planner.replan(
+            planner = self._refusing(start.refused)
+            feet, _ = snap_to_footholds(planner, self.terrain, start.feet, SNAP_RADIUS_M)
+            result = planner.replan(
                 feet,
                 leg,
                 goal=g,
@@ -319,6 +327,27 @@ class PlannerSource:
             return PlanAttempt(None, result.status, reason, wall)
         start_clearance = None if result.initial_pose is None else result.initial_pose.clearance
         return PlanAttempt(result, result.status, "", wall, start_clearance)
+
+    def _refusing(self, refused: tuple[tuple[int, float, float, float], ...]) -> Any:
+        """The planner, or one that keeps every leg out of the discs ``refused`` has ever named.
+
+        Refusals add up over a run: a foothold refused once stays refused
+        (the planner is rebuilt with all of them when a new one comes).
+        """
+        if not refused and not self._refused:
+            return self.planner
+        new = [r for r in refused if r not in self._refused]
+        if new or self._refusing_planner is None:
+            self._refused.extend(new)
+            planner = self.planner
+            front = np.zeros(planner.cost_front.shape, dtype=bool)
+            hind = np.zeros(planner.cost_hind.shape, dtype=bool)
+            for leg, x, y, radius in self._refused:
+                disc_front, disc_hind = planner.refused_masks(leg, x, y, radius)
+                front |= disc_front
+                hind |= disc_hind
+            self._refusing_planner = planner.with_refused((front, hind))
+        return self._refusing_planner
 
     def _plan_from_gentle_start(
         self, pose: tuple[float, float, float], goal: NDArray[np.float64], time_limit: float

@@ -37,6 +37,9 @@ class MeasuredState:
         Trunk position [m] and orientation (w, x, y, z) of the canonical base frame.
     base_vel, base_angvel:
         (3,) trunk linear [m/s] and angular [rad/s] velocity, world axes.
+    com:
+        (3,) the whole robot's centre of mass [m] (MuJoCo's centre of mass
+        of the trunk's subtree, from the physics step's start state).
     feet:
         (4, 3) foot centres [m], canonical legs.
     foot_forces:
@@ -56,6 +59,7 @@ class MeasuredState:
     base_quat: NDArray[np.float64]
     base_vel: NDArray[np.float64]
     base_angvel: NDArray[np.float64]
+    com: NDArray[np.float64]
     feet: NDArray[np.float64]
     foot_forces: NDArray[np.float64]
     trunk_contact: bool
@@ -125,6 +129,7 @@ def measure(world: World) -> MeasuredState:
         base_quat=base_quat,
         base_vel=vel[3:].copy(),
         base_angvel=vel[:3].copy(),
+        com=d.subtree_com[world.base_body].copy(),
         feet=d.geom_xpos[roles.foot].copy(),
         foot_forces=forces,
         trunk_contact=trunk,

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from roughwalk.sim.measured_state import MeasuredState
     from roughwalk.sim.trajectory_buffer import DesiredState
 
-__all__ = ["ReflexMonitor", "ReflexTrigger", "orientation_error"]
+__all__ = ["ReflexMonitor", "ReflexTrigger", "lean_toward", "orientation_error"]
 
 _KINDS = ("body_position", "body_orientation", "foot_position", "foot_force")
 
@@ -55,6 +55,34 @@ def orientation_error(a: np.ndarray, b: np.ndarray) -> float:
     """Angle [rad] of the rotation between orientations ``a`` and ``b`` (w, x, y, z)."""
     rel = quat_multiply(a, b * np.array([1.0, -1.0, -1.0, -1.0]))
     return float(2.0 * np.arccos(np.clip(abs(rel[0]), 0.0, 1.0)))
+
+
+def lean_toward(com: np.ndarray, feet: np.ndarray, support: np.ndarray) -> np.ndarray:
+    """How far [m] the centre of mass leans towards each supporting foot, past the others' line.
+
+    With three feet down (``support`` (4,)), the distance of ``com``'s
+    ground point from the line through the two other supporting feet
+    (``feet`` (4, 3) [m]), positive on the foot's side: the robot leans
+    onto that foot, and gravity presses it down. A robot balanced on that
+    line, or leaning away from it, tips off the foot instead. NaN for a foot
+    not down, or with other than three down.
+    """
+    out = np.full(4, np.nan)
+    down = np.flatnonzero(support)
+    if len(down) != 3:
+        return out
+    p = np.asarray(com, dtype=float)[:2]
+    for leg in down:
+        a, b = (feet[k, :2] for k in down if k != leg)
+        along = b - a
+        length = float(np.linalg.norm(along))
+        if length < 1e-9:
+            continue
+        normal = np.array([-along[1], along[0]]) / length
+        if float(np.dot(feet[leg, :2] - a, normal)) < 0.0:
+            normal = -normal
+        out[leg] = float(np.dot(p - a, normal))
+    return out
 
 
 class ReflexMonitor:
@@ -112,9 +140,15 @@ class ReflexMonitor:
         determinate = bool(np.sum(down) == 3)
         tipping = tilt > cfg.foot_force_tilt_rad
         # A trunk lowered on purpose (a front foot reaching a trench floor)
-        # tilts and leaves a lightly planned foot light: no sign of a tip.
+        # tilts and leaves a lightly planned foot light: no sign of a tip,
+        # while the robot leans onto that foot (it will bear again) rather
+        # than balancing on the other two (board AE: a foot on a rock face).
         descending = self.planned_descent(desired, now) > cfg.foot_force_descent_m_s
-        least = max(cfg.foot_force_n, cfg.foot_force_descent_n) if descending else cfg.foot_force_n
+        least = np.full(4, cfg.foot_force_n)
+        if descending and cfg.foot_force_descent_n > cfg.foot_force_n:
+            lean = lean_toward(measured.com, measured.feet, down)
+            leaning = np.nan_to_num(lean, nan=-np.inf) >= cfg.foot_force_descent_lean_m
+            least = np.where(leaning, cfg.foot_force_descent_n, least)
         loaded = settled & (planned >= least) & determinate & tipping
         shortfall = np.where(loaded, planned - measured.foot_forces[:, 2], 0.0)
         limit = np.where(loaded, (1.0 - cfg.foot_force_fraction) * planned, np.inf)
