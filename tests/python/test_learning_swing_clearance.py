@@ -79,13 +79,13 @@ def test_the_tracking_bench_solves_and_picks_models_at_the_walk_s_clearance() ->
     assert TaskSpace.from_dict(space.to_dict()) == space
     assert "swing_base_clearance" not in SPACE.to_dict()  # runs before the field resume
     # --trajopt's clearance reaches the problem a learned model must fit ...
-    low = bench._spec("single_pallet", False, (("swing_base_clearance", "0.5"),))
-    assert low.swing_base_clearance == 0.5
+    low = bench._spec("single_pallet", False, (("swing_base_clearance", "0.4"),))
+    assert low.swing_base_clearance == 0.4
     why = bench.learned_model_for(
-        "single_pallet", False, "learned", (("swing_base_clearance", "0.5"),)
+        "single_pallet", False, "learned", (("swing_base_clearance", "0.4"),)
     )
     assert "no shipped learned model fits" in why
-    assert "5.5 s, swing_base_clearance 0.5; shipped" in why
+    assert "5.5 s, swing_base_clearance 0.4; shipped" in why
     # ... and an environment's walk brings its own to every solve.
     assert bench._spec("double_pallet", False).swing_base_clearance == (
         bench.swing_clearance("double_pallet")

@@ -103,6 +103,26 @@ def test_the_tracking_bench_finds_a_shipped_model_of_the_double_pallet_s_walk() 
     )
 
 
+def test_the_single_pallet_walk_has_its_own_model_at_0_5_whose_forces_cannot_pull() -> None:
+    from roughwalk.learning.initializer import model_for_spec
+
+    bench = load_benchmark("bench_tracking")
+    space = task_space("single_pallet")
+    assert space.swing_base_clearance == 0.5
+    assert bench.learned_model_for("single_pallet", False) == ""
+    model = model_for_spec("learned", bench._spec("single_pallet", False))
+    assert model.header["problem"]["swing_base_clearance"] == 0.5
+    # Converged plans of the tasks that fell tracked to ~1 cm only once the
+    # forces could not pull between nodes (session 17): the model is trained
+    # so, and the bench solves every start of the environment so.
+    constraints, _ = bench.learned_problem("single_pallet", False)
+    assert constraints is not None and "unilateral_between_nodes" in constraints
+    assert "unilateral_between_nodes" in model.header["constraints"]
+    # The 0.7 model stays for roughwalk optimize's default clearance.
+    default = model_for_spec("learned", ProblemSpec("anymal_c", "single_pallet", "walk", 16, 5.5))
+    assert default.header["problem"].get("swing_base_clearance") is None
+
+
 def test_the_init_bench_takes_the_shipped_model_of_the_environment_s_walk() -> None:
     # The 16-step double-pallet model stays shipped (roughwalk optimize's
     # default walk); the bench must not hand its guesses to the 20-step NLP.

@@ -31,6 +31,13 @@ the hind feet stand on the ground, and no start behind x = −0.30 converged.
 At 0.5 solves grown from converged neighbours converge across the whole box
 (session 16: 516 of 539 starts at x ≤ 0.1, 125 of 143 behind x = −0.30,
 down to x = −0.50).
+
+The single pallet's walk sets 0.5 too (session 17). Its tracking failures
+at 0.7 (a leg link touching the pallet top at 4.0–4.9 s) came after the
+trunk had drifted 20–40 cm off its plan; converged plans of those tasks
+track to about 1 cm once their forces cannot pull between nodes
+(``unilateral_between_nodes``, which its 0.5 model is trained with), and the
+plans ask less of the hips at 0.5.
 """
 
 from __future__ import annotations
@@ -190,7 +197,9 @@ def _triple(value: Any) -> tuple[float, float, float]:
 # goal is 1.5 m ahead of the middle of the same start box. The double
 # pallet's walk: the module docstring.
 ENVIRONMENTS: dict[str, TaskSpace] = {
-    "single_pallet": TaskSpace.for_terrain("single_pallet", (1.6, 0.0, 0.0), edge_x=1.0),
+    "single_pallet": TaskSpace.for_terrain(
+        "single_pallet", (1.6, 0.0, 0.0), edge_x=1.0, swing_base_clearance=0.5
+    ),
     "double_pallet": TaskSpace.for_terrain(
         "double_pallet",
         (1.8, 0.0, 0.0),
