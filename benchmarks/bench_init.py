@@ -62,6 +62,7 @@ from roughwalk.learning import (
     LearnedModel,
     ProblemSpec,
     TaskCostModel,
+    TaskSpace,
     build_problem,
     generate,
     shipped_models,
@@ -77,13 +78,33 @@ RESULTS = Path(__file__).resolve().parent / "results"
 TARGETS = {"median_solve_s": 0.25, "iteration_ratio": 4.0, "beyond_g_max": 0.01}
 
 
-def _models(folder: Path | None, env: str) -> list[tuple[str, LearnedModel]]:
-    """``learned_init_K.npz`` models in ``folder``, else the shipped one of ``env``'s walk."""
+def walk_space(env: str, clearance: str | None = None) -> TaskSpace:
+    """``env``'s task space, its walk at the trunk clearance ``--swing-base-clearance`` names.
+
+    None keeps the environment's own (0.5 on the pallets since sessions
+    16–17); ``"none"`` is the solver's default, the stance clearance over
+    every foot, the problem the 0.7 models were trained on.
+    """
+    space = task_space(env)
+    if clearance is None:
+        return space
+    if clearance.strip().lower() == "none":
+        return replace(space, swing_base_clearance=None)
+    try:
+        value = float(clearance)
+    except ValueError:
+        raise SystemExit(
+            f"--swing-base-clearance takes a number or 'none', got {clearance!r}"
+        ) from None
+    return replace(space, swing_base_clearance=value)
+
+
+def _models(folder: Path | None, space: TaskSpace) -> list[tuple[str, LearnedModel]]:
+    """``learned_init_K.npz`` models in ``folder``, else the shipped one of ``space``'s walk."""
     if folder is not None:
         paths = sorted(folder.glob("learned_init_*.npz"))
         return [(f"LearnedInit-{p.stem.rsplit('_', 1)[1]}", LearnedModel.load(p)) for p in paths]
     out = []
-    space = task_space(env)
     for path in shipped_models():
         model = LearnedModel.load(path)
         problem = model.header["problem"]
@@ -146,9 +167,8 @@ def _set_suffix(spec: ProblemSpec) -> str:
     return ("_with_" + "_".join(extra) if extra else "_" + "_".join(spec.constraints)) + weights
 
 
-def spec_of_models(env: str, models: list[tuple[str, LearnedModel]]) -> ProblemSpec:
+def spec_of_models(space: TaskSpace, models: list[tuple[str, LearnedModel]]) -> ProblemSpec:
     """The held-out problem: every initialiser solves the newest model's constraints and costs."""
-    space = task_space(env)
     spec = ProblemSpec(
         "anymal_c",
         space.terrain,
@@ -204,7 +224,7 @@ def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:
         progress=None,
         indices=indices,
     )
-    models = _models(args.models, args.env)
+    models = _models(args.models, walk_space(args.env, args.swing_base_clearance))
     g_max = None
     cost_model = None
     for name, model in models:
@@ -260,7 +280,7 @@ def timing(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, dict[str, f
         return {}
     problem = build_problem(spec)
     initializers: dict[str, Any] = {"Heuristic": HeuristicInitializer}
-    for name, model in _models(args.models, args.env):
+    for name, model in _models(args.models, walk_space(args.env, args.swing_base_clearance)):
         initializers[name] = lambda model=model: _with_model(LearnedInitializer(), model)
     out = {}
     for name, make in initializers.items():
@@ -403,6 +423,13 @@ def main() -> None:
     parser.add_argument(
         "--timing-tasks", type=int, default=12, help="tasks timed back to back (0: none)"
     )
+    parser.add_argument(
+        "--swing-base-clearance",
+        metavar="H|none",
+        help="the walk's trunk clearance over a swinging foot, as a fraction of the "
+        "stance clearance (default: the environment's, 0.5 on the pallets); 'none': "
+        "the solver's default, the problem the 0.7 models were trained on",
+    )
     parser.add_argument("--json", type=Path, help="output JSON (default results/init_ENV.json)")
     parser.add_argument(
         "--set",
@@ -413,7 +440,8 @@ def main() -> None:
         "solver.dear_guess_restarts=N; the learned run folders record them",
     )
     args = parser.parse_args()
-    spec = spec_of_models(args.env, _models(args.models, args.env))
+    space = walk_space(args.env, args.swing_base_clearance)
+    spec = spec_of_models(space, _models(args.models, space))
     if any(not item.strip().startswith("solver.") for item in args.set):
         raise SystemExit(f"bench init's --set takes solver.NAME=VALUE only, got {args.set}")
     spec = replace(spec, solver=solver_settings(args.set))

@@ -129,7 +129,27 @@ def test_the_init_bench_takes_the_shipped_model_of_the_environment_s_walk() -> N
     bench = load_benchmark("bench_init")
     for env in ("double_pallet", "single_pallet"):
         space = task_space(env)
-        models = bench._models(None, env)
+        models = bench._models(None, space)
         assert len(models) == 1
         problem = models[0][1].header["problem"]
         assert (problem["steps"], problem["duration"]) == (space.steps, space.duration)
+
+
+def test_the_init_bench_measures_the_walk_at_the_clearance_it_is_given() -> None:
+    # The README's init row was measured on the single pallet's 0.7 problem;
+    # since session 17 the walk plans at 0.5, and --swing-base-clearance none
+    # measures the 0.7 problem and its model again.
+    bench = load_benchmark("bench_init")
+    ours = bench.walk_space("single_pallet")
+    assert ours.swing_base_clearance == 0.5
+    (model,) = bench._models(None, ours)
+    assert model[1].header["problem"]["swing_base_clearance"] == 0.5
+    default = bench.walk_space("single_pallet", "none")
+    assert default.swing_base_clearance is None
+    (model,) = bench._models(None, default)
+    assert model[1].header["problem"].get("swing_base_clearance") is None
+    assert bench.spec_of_models(default, [model]).swing_base_clearance is None
+    assert bench.walk_space("single_pallet", "0.6").swing_base_clearance == 0.6
+    assert bench._models(None, bench.walk_space("single_pallet", "0.6")) == []
+    with pytest.raises(SystemExit, match="--swing-base-clearance"):
+        bench.walk_space("single_pallet", "low")
