@@ -51,6 +51,7 @@ from roughwalk.terrain.terrain import Terrain
 
 __all__ = [
     "edge_footholds",
+    "resting_centres",
     "resting_height",
     "steep_footholds",
     "unsafe_footholds",
@@ -79,6 +80,30 @@ def resting_height(terrain: Terrain, foot_radius: float) -> NDArray[np.float64]:
     return np.asarray(
         ndimage.grey_dilation(h, footprint=inside, structure=bump, mode="nearest"), dtype=float
     )
+
+
+def resting_centres(
+    terrain: Terrain, xy: NDArray[np.float64], foot_radius: float
+) -> NDArray[np.float64]:
+    """Centres (n, 3) [m] of spheres of ``foot_radius`` [m] lowered vertically onto ``xy`` (n, 2).
+
+    The pointwise :func:`resting_height` plus the radius, with the terrain
+    read bilinearly at the grid's own spacing over the foot's disc: where
+    the foot rests when put down straight over a foothold, whatever the
+    surface's normal at the one point under its centre.
+    """
+    pts = np.atleast_2d(np.asarray(xy, dtype=float))[:, :2]
+    step = min(terrain.dx, terrain.dy)
+    n = max(int(np.ceil(foot_radius / step)), 1)
+    i, j = np.mgrid[-n : n + 1, -n : n + 1]
+    off = np.column_stack([i.ravel(), j.ravel()]) * (foot_radius / n)
+    d2 = np.sum(off**2, axis=1)
+    keep = d2 <= foot_radius**2 + 1e-15
+    off, d2 = off[keep], d2[keep]
+    bump = np.sqrt(np.maximum(foot_radius**2 - d2, 0.0))
+    h = np.asarray(terrain.height((pts[:, None, :] + off[None]).reshape(-1, 2)), dtype=float)
+    top = np.max(h.reshape(len(pts), len(off)) + bump[None], axis=1)
+    return np.column_stack([pts, top])
 
 
 def edge_footholds(
