@@ -105,6 +105,8 @@ def test_a_foot_on_a_flank_is_replanted_on_the_nearest_gentle_foothold() -> None
     assert np.linalg.norm(target[:2] - feet[1, :2]) <= 0.025 + 1e-9
     i, j = round(target[0] / DX), round((target[1] + 0.3) / DX)
     assert not steep[i, j]
+    # Not where the nearest gentle foothold is nearer than asked for.
+    assert replant_targets(source.planner, terrain, feet, r, 0.025, steep, 0.03) == []
     # Its centre rests on the ground there: on it or, the flank within its disc, above it.
     assert target[2] >= float(terrain.height(target[None, :2])[0]) + r - 1e-9
 

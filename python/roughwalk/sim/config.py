@@ -539,12 +539,13 @@ class ReflexConfig:
         9–12 roll over in their first recovery either way); seeds 0–1 of
         the other six classes the same runs but logs seed 1, which still
         fails, two reflexes later.
-    replant_max_slope, replant_snap_m, replant_s, replant_margin_m:
+    replant_max_slope, replant_snap_m, replant_min_m, replant_s, replant_margin_m:
         After a recovery settles and before the re-plan, a foot standing on
         a slope steeper than ``replant_max_slope`` [rad] (the mean over the
         foot's disc, as ``executor.start_max_slope`` judges a start foot)
-        or on no foothold the planner allows is lifted and put down on the
-        nearest foothold within ``replant_snap_m`` [m] no steeper than that
+        is lifted and put down on the nearest foothold within
+        ``replant_snap_m`` [m] no steeper than that, if that is at least
+        ``replant_min_m`` [m] away
         (:func:`~roughwalk.sim.recovery.replant_segments`): the trunk moves
         until its centre of mass is ``replant_margin_m`` [m] inside the
         other three feet, the foot steps, the trunk returns over the four,
@@ -552,8 +553,10 @@ class ReflexConfig:
         Each leg at most once per recovery; none where the other three
         cannot hold the trunk. Without it the re-plan starts on the foot
         where it slid (a 76° rock face after large rocks seed 4's first
-        recovery) or drags it along the ground onto the snapped foothold
-        in the blend into the new plan. π/2: off.
+        recovery). Each step costs about a second: re-planting feet
+        merely off the footholds by millimetres (which the re-plan snaps)
+        made large rocks seed 2 walk 1.93 cm/s with 4 reflexes (6.20 and
+        1 without), so only feet on a face step. π/2: off.
     recovery_slide_m, recovery_slides:
         During a recovery, no reflex watches the feet; with this, a foot
         the recovery holds on its foothold that slides more than
@@ -598,6 +601,7 @@ class ReflexConfig:
     replan_nudge_any_leg: bool = True
     replant_max_slope: float = 0.5 * math.pi
     replant_snap_m: float = 0.025
+    replant_min_m: float = 0.01
     replant_s: float = 0.25
     replant_margin_m: float = 0.015
     recovery_slide_m: float = 0.0
@@ -634,6 +638,7 @@ class ReflexConfig:
                 "replan_nudge_m",
                 "settle_max_s",
                 "replant_snap_m",
+                "replant_min_m",
                 "replant_margin_m",
                 "recovery_slide_m",
             ),

@@ -617,7 +617,7 @@ class Executor:
         if self._steep is None:
             self._steep = steep_footholds(terrain, r, cfg.replant_max_slope)
         for leg, target in replant_targets(
-            planner, terrain, measured.feet, r, cfg.replant_snap_m, self._steep
+            planner, terrain, measured.feet, r, cfg.replant_snap_m, self._steep, cfg.replant_min_m
         ):
             if leg in self._replanted:
                 continue
