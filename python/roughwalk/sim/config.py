@@ -556,7 +556,16 @@ class ReflexConfig:
         recovery). Each step costs about a second: re-planting feet
         merely off the footholds by millimetres (which the re-plan snaps)
         made large rocks seed 2 walk 1.93 cm/s with 4 reflexes (6.20 and
-        1 without), so only feet on a face step. π/2: off.
+        1 without), so only feet on a face step. π/2: off. Session 17
+        (``bench_littledog.py --expansions 40000``, one process per seed,
+        main and the branch), 40° with ``recovery_slide_m`` 0.015: large
+        rocks 0–7 5/8 at 5.30 → 5/8 at 5.63 cm/s, 14 → 9 reflexes (seed
+        4 rescued at 4.33: RF steps 1.7 cm off a 76° face; seed 5 lost:
+        LH stepped 1 cm down a flank and no stance within 2 cm of the new
+        one has a certificate); logs 0–5 4/6 → 3/6 (seed 1 lost after 3
+        reflexes). With ``executor.start_max_slope`` 40° as well: large
+        rocks 0–7 5/8 at 6.47 cm/s with 5 reflexes; held-out 8–15 and
+        logs in ``docs/measurements.md``. Success is not better: off.
     recovery_slide_m, recovery_slides:
         During a recovery, no reflex watches the feet; with this, a foot
         the recovery holds on its foothold that slides more than
@@ -564,7 +573,14 @@ class ReflexConfig:
         three bear load, is put down again: the recovery starts over from
         where the robot is, that foot lowered like a lifted one onto the
         nearest gentle foothold (``replant_max_slope``) or where it is, at
-        most ``recovery_slides`` times per reflex. 0: off.
+        most ``recovery_slides`` times per reflex. 0: off. In session 17's
+        runs (see ``replant_max_slope``) it fired once, on large rocks seed
+        7 (LF, 3.0 s), and that run still fell as on main. In the two
+        traced recoveries where a slide ended the run, fewer than three
+        other feet bore load, where putting a foot down again cannot help:
+        large rocks seed 4's second recovery on main (RF slid 0.17 s in,
+        LF and RH still being lowered) and, with ``executor.start_max_slope``
+        40°, its first (at the reflex only LF bore load, 1 N).
     max_reflexes:
         Give up (a failed run) after this many reflexes.
     end_at_goal:

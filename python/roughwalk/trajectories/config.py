@@ -834,6 +834,11 @@ class TrajectoryConfig:
         straight onto the contact's (x, y), over the whole foot's disc as
         the planner's slope and rim checks judge it
         (:func:`~roughwalk.trajectories.step_sequence._foot_centres`).
+        Session 17 (``bench_littledog.py --expansions 40000``): large rocks
+        seed 2 falls with "resting" (main 6.20 cm/s), seed 3 walks 6.06
+        (5.36). Touchdowns land within 0.9 cm of their plan with either,
+        so the aim is not what puts feet on steep faces (see
+        ``footstep.max_contact_slope``): "normal" stays.
     timing, zmp, swing, chomp, validity:
         The stages' settings.
     """
