@@ -258,3 +258,18 @@ def test_a_foot_lowered_beside_a_ridge_rests_on_its_corner() -> None:
     assert lean == pytest.approx(np.degrees(np.arcsin(0.0045 / r)), abs=2.0)
     assert leaning_footholds(terrain, r, np.radians(20.0))[i, 20]
     assert not leaning_footholds(terrain, r, 0.5 * np.pi).any()
+
+    # The planner refuses such a foothold with footstep.max_contact_slope, not without
+    # (a board-sized copy on a 1 mm grid, for the learned cost's features).
+    big = np.arange(0.0, 0.4, 0.001)
+    ridge = np.where(np.abs(big - 0.2) <= 0.0015 + 1e-9, 0.005, 0.0)[:, None] * np.ones((1, 300))
+    board = Terrain(ridge, x0=0.0, y0=0.0, dx=0.001, dy=0.001, name="ridge")
+    robot = rw.load_robot("littledog")
+    on = FootstepPlanner(
+        robot, board, FootstepConfig.for_robot(robot, max_contact_slope=np.radians(20.0))
+    )
+    off = FootstepPlanner(robot, board, FootstepConfig.for_robot(robot))
+    k = _cell(board, 0.194, 0.15)  # 5 mm beside the ridge: a 29° contact
+    assert np.isinf(on.cost_front[k]) and np.isinf(on.cost_hind[k])
+    assert np.isfinite(off.cost_front[k])
+    assert np.isfinite(on.cost_front[_cell(board, 0.1, 0.15)])  # flat ground stays
