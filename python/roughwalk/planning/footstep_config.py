@@ -329,8 +329,9 @@ class FootstepConfig:
         turns the check off, as by default: at 45° (``bench_littledog.py
         --expansions 40000``, one process per seed) large rocks 0–7 5/8 at
         5.30 → 5/8 at 5.95 cm/s (seed 7 rescued, seed 2 lost), logs 0–5
-        4/6 at 7.71 → 4/6 at 8.26 (seed 5 rescued, seed 1 lost); held-out
-        seeds and the other classes not yet measured.
+        4/6 at 7.71 → 4/6 at 8.26 (seed 5 rescued, seed 1 lost), held-out
+        large rocks 8–15 4/8 at 6.40 → 5/8 at 6.16; the other classes not
+        yet measured.
     wall_reach:
         A cell is no foothold for the front legs where the terrain rises more
         than ``wall_height`` above the sole of a foot resting there within
