@@ -24,7 +24,9 @@ import pytest
 import roughwalk as rw
 from roughwalk.planning import FootstepConfig, FootstepPlanner
 from roughwalk.planning.foothold_safety import (
+    contact_slopes,
     edge_footholds,
+    leaning_footholds,
     resting_height,
     steep_footholds,
     wall_footholds,
@@ -230,3 +232,44 @@ def test_the_wall_check_refuses_rf_the_gap_floor_beside_the_near_wall_and_keeps_
     # wall, hind feet near its near one, where the plans' other feet stood.
     assert np.isfinite(walk.cost_front[_cell(gap, 1.03, -0.04)])
     assert np.isfinite(walk.cost_hind[_cell(gap, 0.975, -0.068)])
+
+
+@pytest.mark.parametrize("degrees", [10.0, 30.0, 50.0])
+def test_a_foot_on_a_plane_leans_as_the_plane(degrees: float) -> None:
+    """On a plane the resting sphere's contact leans by the plane's slope (grid-quantised)."""
+    dx = 0.0005
+    x = np.arange(0.0, 0.1, dx)
+    h = np.tan(np.radians(degrees)) * x[:, None] * np.ones((1, len(x)))
+    terrain = Terrain(h, x0=0.0, y0=0.0, dx=dx, dy=dx, name="plane")
+    lean = np.degrees(contact_slopes(terrain, 0.0103))[50:-50, 50:-50]
+    assert np.all(np.abs(lean - degrees) < 2.5)
+
+
+def test_a_foot_lowered_beside_a_ridge_rests_on_its_corner() -> None:
+    """A 5 mm ridge 3 mm wide on flat ground; a foot lowered with its centre 4.5 mm
+    beside the ridge rests on the ridge's corner, leaning asin(4.5 / 10.3) = 26°."""
+    dx = 0.0005
+    x = np.arange(0.0, 0.1, dx)
+    h = np.where(np.abs(x - 0.05) <= 0.0015 + 1e-9, 0.005, 0.0)[:, None] * np.ones((1, 40))
+    terrain = Terrain(h, x0=0.0, y0=0.0, dx=dx, dy=dx, name="ridge")
+    r = 0.0103
+    i = int(round(0.044 / dx))  # foot centre 6 mm from the ridge's middle, 4.5 mm from its side
+    lean = np.degrees(contact_slopes(terrain, r))[i, 20]
+    assert lean == pytest.approx(np.degrees(np.arcsin(0.0045 / r)), abs=2.0)
+    assert leaning_footholds(terrain, r, np.radians(20.0))[i, 20]
+    assert not leaning_footholds(terrain, r, 0.5 * np.pi).any()
+
+    # The planner refuses such a foothold with footstep.max_contact_slope, not without
+    # (a board-sized copy on a 1 mm grid, for the learned cost's features).
+    big = np.arange(0.0, 0.4, 0.001)
+    ridge = np.where(np.abs(big - 0.2) <= 0.0015 + 1e-9, 0.005, 0.0)[:, None] * np.ones((1, 300))
+    board = Terrain(ridge, x0=0.0, y0=0.0, dx=0.001, dy=0.001, name="ridge")
+    robot = rw.load_robot("littledog")
+    on = FootstepPlanner(
+        robot, board, FootstepConfig.for_robot(robot, max_contact_slope=np.radians(20.0))
+    )
+    off = FootstepPlanner(robot, board, FootstepConfig.for_robot(robot))
+    k = _cell(board, 0.194, 0.15)  # 5 mm beside the ridge: a 29° contact
+    assert np.isinf(on.cost_front[k]) and np.isinf(on.cost_hind[k])
+    assert np.isfinite(off.cost_front[k])
+    assert np.isfinite(on.cost_front[_cell(board, 0.1, 0.15)])  # flat ground stays

@@ -50,7 +50,10 @@ from scipy import ndimage
 from roughwalk.terrain.terrain import Terrain
 
 __all__ = [
+    "contact_slopes",
     "edge_footholds",
+    "leaning_footholds",
+    "resting_centres",
     "resting_height",
     "steep_footholds",
     "unsafe_footholds",
@@ -79,6 +82,65 @@ def resting_height(terrain: Terrain, foot_radius: float) -> NDArray[np.float64]:
     return np.asarray(
         ndimage.grey_dilation(h, footprint=inside, structure=bump, mode="nearest"), dtype=float
     )
+
+
+def resting_centres(
+    terrain: Terrain, xy: NDArray[np.float64], foot_radius: float
+) -> NDArray[np.float64]:
+    """Centres (n, 3) [m] of spheres of ``foot_radius`` [m] lowered vertically onto ``xy`` (n, 2).
+
+    The pointwise :func:`resting_height` plus the radius, with the terrain
+    read bilinearly at the grid's own spacing over the foot's disc: where
+    the foot rests when put down straight over a foothold, whatever the
+    surface's normal at the one point under its centre.
+    """
+    pts = np.atleast_2d(np.asarray(xy, dtype=float))[:, :2]
+    step = min(terrain.dx, terrain.dy)
+    n = max(int(np.ceil(foot_radius / step)), 1)
+    i, j = np.mgrid[-n : n + 1, -n : n + 1]
+    off = np.column_stack([i.ravel(), j.ravel()]) * (foot_radius / n)
+    d2 = np.sum(off**2, axis=1)
+    keep = d2 <= foot_radius**2 + 1e-15
+    off, d2 = off[keep], d2[keep]
+    bump = np.sqrt(np.maximum(foot_radius**2 - d2, 0.0))
+    h = np.asarray(terrain.height((pts[:, None, :] + off[None]).reshape(-1, 2)), dtype=float)
+    top = np.max(h.reshape(len(pts), len(off)) + bump[None], axis=1)
+    return np.column_stack([pts, top])
+
+
+def contact_slopes(terrain: Terrain, foot_radius: float) -> NDArray[np.float64]:
+    """Slope [rad] of the contact a sphere of ``foot_radius`` [m] lowered onto each cell makes.
+
+    (nx, ny), x-major. The sphere lowered straight down rests on the cell p
+    within its disc that maximises h(p) + √(r² − |p − c|²); its contact
+    normal then leans asin(|p − c| / r) from vertical. That, not the disc's
+    mean slope (:func:`steep_footholds`), is the face a foot pressed down
+    there stands on: where it leans beyond the friction cone, the foot slides.
+    """
+    h = np.asarray(terrain.heights, dtype=float)
+    inside, d2 = _disc(foot_radius, terrain.dx, terrain.dy)
+    ni, nj = (inside.shape[0] - 1) // 2, (inside.shape[1] - 1) // 2
+    padded = np.pad(h, ((ni, ni), (nj, nj)), mode="edge")
+    best = np.full(h.shape, -np.inf)
+    lean = np.zeros(h.shape)
+    for a, b in zip(*np.nonzero(inside), strict=True):
+        top = padded[a : a + h.shape[0], b : b + h.shape[1]] + np.sqrt(
+            max(foot_radius**2 - d2[a, b], 0.0)
+        )
+        higher = top > best
+        best = np.where(higher, top, best)
+        lean = np.where(higher, np.sqrt(d2[a, b]), lean)
+    return np.asarray(np.arcsin(np.clip(lean / foot_radius, 0.0, 1.0)), dtype=float)
+
+
+def leaning_footholds(terrain: Terrain, foot_radius: float, max_slope: float) -> NDArray[np.bool_]:
+    """Cells (nx, ny) whose contact leans beyond ``max_slope`` [rad] (:func:`contact_slopes`).
+
+    ``max_slope`` ≥ π/2 marks none.
+    """
+    if max_slope >= 0.5 * np.pi:
+        return np.zeros(np.asarray(terrain.heights).shape, dtype=bool)
+    return np.asarray(contact_slopes(terrain, foot_radius) > max_slope, dtype=bool)
 
 
 def edge_footholds(

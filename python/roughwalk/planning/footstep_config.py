@@ -317,6 +317,21 @@ class FootstepConfig:
         normal's tilt instead (the gradient of the resting height, which
         bridges cracks) at 45° gave logs 2/4: the flanks' contact tilts
         (45–56°) lie nearer the cone than their slopes.
+    max_contact_slope:
+        A cell is no foothold where the contact a foot lowered onto it makes
+        leans more than this [rad] from vertical
+        (:func:`~roughwalk.planning.foothold_safety.contact_slopes`), on top
+        of ``max_foothold_slope``'s mean over the disc. Of board AE's cells
+        the walk's 45° disc limit and 3 cm rim check accept, 14 % rest the
+        foot on a contact leaning beyond 45° (AD: 4 %); of 56 touchdowns in
+        session 17's large-rocks runs, all within 0.9 cm of their plan, the
+        5 that came down on such a contact were 4 planned on one. π/2
+        turns the check off, as by default: at 45° (``bench_littledog.py
+        --expansions 40000``, one process per seed) large rocks 0–7 5/8 at
+        5.30 → 5/8 at 5.95 cm/s (seed 7 rescued, seed 2 lost), logs 0–5
+        4/6 at 7.71 → 4/6 at 8.26 (seed 5 rescued, seed 1 lost), held-out
+        large rocks 8–15 4/8 at 6.40 → 5/8 at 6.16; the other classes not
+        yet measured.
     wall_reach:
         A cell is no foothold for the front legs where the terrain rises more
         than ``wall_height`` above the sole of a foot resting there within
@@ -378,6 +393,7 @@ class FootstepConfig:
     edge_drop: float = 0.0
     edge_margin: float = 0.0
     max_foothold_slope: float = math.pi / 2
+    max_contact_slope: float = math.pi / 2
     wall_reach: float = 0.0
     wall_height: float = 0.09
 
@@ -427,6 +443,7 @@ class FootstepConfig:
         _check("edge_drop", self.edge_drop)
         _check("edge_margin", self.edge_margin)
         _check("max_foothold_slope", self.max_foothold_slope)
+        _check("max_contact_slope", self.max_contact_slope)
         _check("wall_reach", self.wall_reach)
         _check("wall_height", self.wall_height)
         if not math.isfinite(self.crossing_margin) or not math.isfinite(self.cost_heading):
@@ -530,6 +547,7 @@ class FootstepConfig:
             "edge_drop",
             "edge_margin",
             "max_foothold_slope",
+            "max_contact_slope",
             "wall_reach",
             "wall_height",
         ):

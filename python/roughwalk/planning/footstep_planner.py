@@ -23,7 +23,11 @@ from numpy.typing import ArrayLike
 
 from roughwalk import _core
 from roughwalk.errors import InvalidArgumentError, PlanningError, TerrainError
-from roughwalk.planning.foothold_safety import unsafe_footholds, wall_footholds
+from roughwalk.planning.foothold_safety import (
+    leaning_footholds,
+    unsafe_footholds,
+    wall_footholds,
+)
 from roughwalk.planning.footstep_config import LEG_INDEX, FootstepConfig
 from roughwalk.planning.footstep_cost import FootholdCost, default_terrain_cost
 from roughwalk.planning.footstep_plan import (
@@ -116,6 +120,11 @@ class FootstepPlanner:
             )
             self.cost_front = np.where(unsafe, np.inf, self.cost_front)
             self.cost_hind = np.where(unsafe, np.inf, self.cost_hind)
+        if c.max_contact_slope < 0.5 * np.pi:
+            # A foot whose contact leans beyond the cone slides, whatever the disc's mean slope.
+            leaning = leaning_footholds(terrain, robot.foot_radius, c.max_contact_slope)
+            self.cost_front = np.where(leaning, np.inf, self.cost_front)
+            self.cost_hind = np.where(leaning, np.inf, self.cost_hind)
         if c.wall_reach > 0:
             # Where a knee would meet a wall's rim, for each end's knees.
             for end in ("front", "hind"):

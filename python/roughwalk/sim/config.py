@@ -562,6 +562,48 @@ class ReflexConfig:
         9–12 roll over in their first recovery either way); seeds 0–1 of
         the other six classes the same runs but logs seed 1, which still
         fails, two reflexes later.
+    replant_max_slope, replant_snap_m, replant_min_m, replant_s, replant_margin_m:
+        After a recovery settles and before the re-plan, a foot standing on
+        a slope steeper than ``replant_max_slope`` [rad] (the mean over the
+        foot's disc, as ``executor.start_max_slope`` judges a start foot)
+        is lifted and put down on the nearest foothold within
+        ``replant_snap_m`` [m] no steeper than that, if that is at least
+        ``replant_min_m`` [m] away
+        (:func:`~roughwalk.sim.recovery.replant_segments`): the trunk moves
+        until its centre of mass is ``replant_margin_m`` [m] inside the
+        other three feet, the foot steps, the trunk returns over the four,
+        each motion taking ``replant_s`` [s], and the robot settles again.
+        Each leg at most once per recovery; none where the other three
+        cannot hold the trunk. Without it the re-plan starts on the foot
+        where it slid (a 76° rock face after large rocks seed 4's first
+        recovery). Each step costs about a second: re-planting feet
+        merely off the footholds by millimetres (which the re-plan snaps)
+        made large rocks seed 2 walk 1.93 cm/s with 4 reflexes (6.20 and
+        1 without), so only feet on a face step. π/2: off. Session 17
+        (``bench_littledog.py --expansions 40000``, one process per seed,
+        main and the branch), 40° with ``recovery_slide_m`` 0.015: large
+        rocks 0–7 5/8 at 5.30 → 5/8 at 5.63 cm/s, 14 → 9 reflexes (seed
+        4 rescued at 4.33: RF steps 1.7 cm off a 76° face; seed 5 lost:
+        LH stepped 1 cm down a flank and no stance within 2 cm of the new
+        one has a certificate); logs 0–5 4/6 → 3/6 (seed 1 lost after 3
+        reflexes). With ``executor.start_max_slope`` 40° as well: large
+        rocks 0–7 5/8 at 6.47 cm/s with 5 reflexes; held-out 8–15 and
+        logs in ``docs/measurements.md``. Success is not better: off.
+    recovery_slide_m, recovery_slides:
+        During a recovery, no reflex watches the feet; with this, a foot
+        the recovery holds on its foothold that slides more than
+        ``recovery_slide_m`` [m] off it for ``persist_s``, while the other
+        three bear load, is put down again: the recovery starts over from
+        where the robot is, that foot lowered like a lifted one onto the
+        nearest gentle foothold (``replant_max_slope``) or where it is, at
+        most ``recovery_slides`` times per reflex. 0: off. In session 17's
+        runs (see ``replant_max_slope``) it fired once, on large rocks seed
+        7 (LF, 3.0 s), and that run still fell as on main. In the two
+        traced recoveries where a slide ended the run, fewer than three
+        other feet bore load, where putting a foot down again cannot help:
+        large rocks seed 4's second recovery on main (RF slid 0.17 s in,
+        LF and RH still being lowered) and, with ``executor.start_max_slope``
+        40°, its first (at the reflex only LF bore load, 1 N).
     max_reflexes:
         Give up (a failed run) after this many reflexes.
     end_at_goal:
@@ -597,6 +639,13 @@ class ReflexConfig:
     replan_nudge_m: float = 0.02
     replan_from_trunk: bool = True
     replan_nudge_any_leg: bool = True
+    replant_max_slope: float = 0.5 * math.pi
+    replant_snap_m: float = 0.025
+    replant_min_m: float = 0.01
+    replant_s: float = 0.25
+    replant_margin_m: float = 0.015
+    recovery_slide_m: float = 0.0
+    recovery_slides: int = 2
     max_reflexes: int = 6
     end_at_goal: bool = True
 
@@ -611,6 +660,8 @@ class ReflexConfig:
                 "lower_s",
                 "replan_budget_s",
                 "settled_rate_rad_s",
+                "replant_max_slope",
+                "replant_s",
             ),
             "reflex",
         )
@@ -626,12 +677,20 @@ class ReflexConfig:
                 "capture_max_m",
                 "replan_nudge_m",
                 "settle_max_s",
+                "replant_snap_m",
+                "replant_min_m",
+                "replant_margin_m",
+                "recovery_slide_m",
             ),
             "reflex",
         )
         if self.settled_loaded_feet not in (3, 4) or isinstance(self.settled_loaded_feet, bool):
             raise ConfigError(
                 f"reflex.settled_loaded_feet must be 3 or 4, got {self.settled_loaded_feet!r}"
+            )
+        if not (isinstance(self.recovery_slides, int) and self.recovery_slides >= 0):
+            raise ConfigError(
+                f"reflex.recovery_slides must be an integer ≥ 0, got {self.recovery_slides}"
             )
         if not (isinstance(self.max_reflexes, int) and self.max_reflexes >= 0):
             raise ConfigError(

@@ -30,9 +30,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from roughwalk.errors import PlanningError
+from roughwalk.planning.foothold_safety import steep_footholds
 from roughwalk.robots.canonical_frame import LEG_NAMES
 from roughwalk.sim.config import SimConfig
 from roughwalk.sim.cop_stabilizer import CopStabilizer
+from roughwalk.sim.foothold_snap import replant_targets
 from roughwalk.sim.footstep_source import CRAWL_ORDER, FootstepSource, PlanAttempt, PlanStart
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
@@ -42,7 +44,9 @@ from roughwalk.sim.recovery import (
     hold_segment,
     pose_segment,
     recovery_segment,
+    replant_segments,
     settled,
+    sliding_leg,
     standing_feet,
 )
 from roughwalk.sim.reflexes import ReflexMonitor
@@ -187,6 +191,13 @@ class Executor:
         # When the recovery's hold stops waiting for the robot to settle [s].
         self._settle_deadline: float | None = None
         self._goal = np.zeros(2)
+        # Legs re-planted in this recovery, and the cells too steep to re-plant on.
+        self._replanted: set[int] = set()
+        self._steep: np.ndarray | None = None
+        # Slides caught in this recovery, since when one lasts, the recovery's footholds.
+        self._slides = 0
+        self._slide_since: float | None = None
+        self._recovery_footholds = np.zeros((4, 3))
 
     # ---- planning -------------------------------------------------------------------
 
@@ -319,6 +330,8 @@ class Executor:
                     # Recovered on four feet inside the goal radius: the run is done.
                     log.event(now, "settled_at_goal")
                     break
+                elif mode == "recovery" and self._replant(measured, now):
+                    pass  # a foot steps off a face onto a foothold, then the robot settles
                 elif mode == "recovery":
                     # Settled on four feet: re-plan from where they stand (§6, §4.5).
                     replans += 1
@@ -341,6 +354,11 @@ class Executor:
             # The trunk's target moved by the CoP stabiliser's shift: what the
             # integrators hold and the reflexes judge.
             steered = self.stabilizer.update(desired, measured)
+            slid = self._recovery_slide(measured, desired, now) if mode == "recovery" else None
+            if slid is not None:
+                log.event(now, "recovery_slide", leg=LEG_NAMES[slid], foot=measured.feet[slid])
+                desired = self._start_recovery(measured, desired, now, slid=slid)
+                steered = desired
             if mode in ("walk", "wait") and monitor.first_motion is not None:
                 trigger = self.reflexes.check(steered, measured)
                 if trigger is not None:
@@ -524,15 +542,27 @@ class Executor:
         return int(plan.legs[k + 1]) if k + 1 < len(plan.legs) else leg
 
     def _start_recovery(
-        self, measured: MeasuredState, desired: DesiredState, now: float
+        self,
+        measured: MeasuredState,
+        desired: DesiredState,
+        now: float,
+        slid: int | None = None,
     ) -> DesiredState:
-        """Clear the buffer and queue the reflex's motion; returns the desired state to use now."""
+        """Clear the buffer and queue the reflex's motion; returns the desired state to use now.
+
+        ``slid``: a foot that slid during the recovery under way (see
+        ``reflex.recovery_slide_m``): the recovery starts again from where
+        the robot is, with that foot put down again like a lifted one.
+        """
         cfg = self.config.reflex
         current = self.buffer.current
-        planned = current.last().feet if current is not None else desired.feet
-        self._reflex_next_leg = self._next_leg(desired)
+        planned = np.array(current.last().feet if current is not None else desired.feet)
         self._settle_deadline = None
-        self._reflex_planned_feet = np.array(planned, dtype=float)
+        if slid is None:
+            self._reflex_next_leg = self._next_leg(desired)
+            self._replanted = set()
+            self._slides = 0
+            self._reflex_planned_feet = np.array(planned, dtype=float)
         in_contact = measured.foot_forces[:, 2] > _LOADED_N
         bearing = (
             standing_feet(
@@ -541,6 +571,10 @@ class Executor:
             if cfg.standing_bear
             else in_contact
         )
+        if slid is not None:
+            in_contact[slid] = bearing[slid] = False
+            planned[slid] = self._replant_target(measured, slid)
+        self._slide_since = None
         self._plan = None
         self.buffer.clear()
         self.integrator.reset()
@@ -561,10 +595,104 @@ class Executor:
         )
         for s in segments:
             self.buffer.append(s)
+        self._recovery_footholds = footholds
         self.log.event(now, "recovery", footholds=footholds, feet_down=in_contact)
         state, _, _ = self.buffer.advance(now)
         assert state is not None
         return state
+
+    def _replant_target(self, measured: MeasuredState, leg: int) -> np.ndarray:
+        """Where a foot that slid goes down again: the nearest gentle foothold, or where it is.
+
+        The foothold as ``reflex.replant_max_slope`` finds one (when that is
+        on and the source has a planner), else the foot's own position.
+        """
+        cfg = self.config.reflex
+        planner = getattr(self.source, "planner", None)
+        foot = np.array(measured.feet[leg], dtype=float)
+        if cfg.replant_max_slope >= 0.5 * np.pi or cfg.replant_snap_m <= 0 or planner is None:
+            return foot
+        terrain = self.terrain_for_recovery
+        r = self.robot.foot_radius
+        if self._steep is None:
+            self._steep = steep_footholds(terrain, r, cfg.replant_max_slope)
+        for moved, target in replant_targets(
+            planner, terrain, measured.feet, r, cfg.replant_snap_m, self._steep
+        ):
+            if moved == leg:
+                return np.asarray(target, dtype=float)
+        return foot
+
+    def _recovery_slide(
+        self, measured: MeasuredState, desired: DesiredState, now: float
+    ) -> int | None:
+        """The foot to put down again if one slides during the recovery, else None.
+
+        See ``reflex.recovery_slide_m``: a foot the recovery holds on its
+        foothold (desired there and supporting) more than that from it
+        for ``reflex.persist_s``, while the other three bear load.
+        """
+        cfg = self.config.reflex
+        if cfg.recovery_slide_m <= 0 or self._slides >= cfg.recovery_slides:
+            return None
+        leg = sliding_leg(
+            measured,
+            desired,
+            self._recovery_footholds,
+            cfg.recovery_slide_m,
+            _LOADED_N,
+        )
+        if leg is None:
+            self._slide_since = None
+            return None
+        if self._slide_since is None:
+            self._slide_since = now
+        if now - self._slide_since < cfg.persist_s - 1e-12:
+            return None
+        self._slides += 1
+        return leg
+
+    def _replant(self, measured: MeasuredState, now: float) -> bool:
+        """Queue a settled robot's step off a face onto a foothold; whether one was queued.
+
+        See ``reflex.replant_max_slope``: the first leg (canonical order) not
+        yet re-planted in this recovery whose foot stands on a face or off
+        the footholds, if the other three can hold the trunk.
+        """
+        cfg = self.config.reflex
+        planner = getattr(self.source, "planner", None)
+        if cfg.replant_max_slope >= 0.5 * np.pi or cfg.replant_snap_m <= 0 or planner is None:
+            return False
+        terrain = self.terrain_for_recovery
+        r = self.robot.foot_radius
+        if self._steep is None:
+            self._steep = steep_footholds(terrain, r, cfg.replant_max_slope)
+        for leg, target in replant_targets(
+            planner, terrain, measured.feet, r, cfg.replant_snap_m, self._steep, cfg.replant_min_m
+        ):
+            if leg in self._replanted:
+                continue
+            self._replanted.add(leg)
+            segments = replant_segments(
+                self.robot,
+                measured,
+                leg,
+                target,
+                cfg.replant_s,
+                cfg.settle_s,
+                now,
+                cfg.replant_margin_m,
+            )
+            if segments is None:
+                continue
+            self._settle_deadline = None
+            for segment in segments:
+                self.buffer.append(segment)
+            self.log.event(
+                now, "replant", leg=LEG_NAMES[leg], foot=measured.feet[leg], target=target
+            )
+            return True
+        return False
 
     def _settled(self, measured: MeasuredState, now: float) -> bool:
         """Whether the recovered robot stands still on four feet, or has held long enough.

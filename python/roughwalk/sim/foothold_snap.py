@@ -19,11 +19,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
+from roughwalk.planning.foothold_safety import resting_centres
+
 if TYPE_CHECKING:
     from roughwalk.planning.footstep_planner import FootstepPlanner
     from roughwalk.terrain.terrain import Terrain
 
-__all__ = ["snap_to_footholds"]
+__all__ = ["replant_targets", "snap_to_footholds"]
 
 
 def _foothold(
@@ -91,3 +93,30 @@ def snap_to_footholds(
         out[leg, :2] = xy[int(np.argmax(ok))]
         moved.append(leg)
     return out, moved
+
+
+def replant_targets(
+    planner: FootstepPlanner,
+    terrain: Terrain,
+    feet: NDArray[np.float64],
+    foot_radius: float,
+    radius: float,
+    refused: NDArray[np.bool_],
+    at_least: float = 0.0,
+) -> list[tuple[int, NDArray[np.float64]]]:
+    """The feet (4, 3) [m] a recovered robot should re-plant, and where: [(leg, centre (3,))].
+
+    A foot on a ``refused`` cell (a face too steep) goes to the nearest
+    foothold within ``radius`` [m] that is not refused
+    (:func:`snap_to_footholds`), if that is at least ``at_least`` [m]
+    away, its centre where a sphere of ``foot_radius`` [m] rests there.
+    A foot merely a few millimetres off the footholds stays: the re-plan
+    snaps it. Legs in canonical order.
+    """
+    snapped, moved = snap_to_footholds(planner, terrain, feet, radius, refused=refused)
+    steep = _on(refused, terrain, np.asarray(feet, dtype=float)[:, :2])
+    return [
+        (leg, resting_centres(terrain, snapped[leg : leg + 1, :2], foot_radius)[0])
+        for leg in sorted(moved)
+        if steep[leg] and np.linalg.norm(snapped[leg, :2] - feet[leg, :2]) >= at_least
+    ]

@@ -14,6 +14,13 @@ three parts, from the measured state:
    with its centre of mass over the feet's centroid (:func:`centred_fit`);
 3. it holds still so the robot settles before re-planning.
 
+Settled, a foot may still stand where no walk should start: slid onto a
+rock's face steeper than the friction cone, or off every foothold the
+planner allows. :func:`replant_segments` lifts such a foot and puts it
+down on the nearest foothold (the trunk first over the other three feet,
+then back over all four), as the start of a run moves a foot put down on
+a flank (:func:`~roughwalk.sim.foothold_snap.snap_to_footholds`).
+
 Motions are minimum-jerk in joint angles and trunk pose, long enough that
 no joint exceeds half its velocity limit.
 """
@@ -27,7 +34,7 @@ from numpy.typing import NDArray
 
 from roughwalk.robots._rotations import quat_to_matrix
 from roughwalk.sim.trajectory_buffer import DesiredState, Segment
-from roughwalk.trajectories.body_keyframes import nominal_fit
+from roughwalk.trajectories.body_keyframes import nominal_fit, pose_over_support
 from roughwalk.trajectories.contact_forces import static_contact_forces
 from roughwalk.trajectories.euler import matrix_to_rpy, rpy_to_quat
 from roughwalk.trajectories.whole_body import WholeBody
@@ -39,6 +46,8 @@ if TYPE_CHECKING:
 
 __all__ = [
     "recovery_segment",
+    "replant_segments",
+    "sliding_leg",
     "centred_fit",
     "hold_segment",
     "blend_segment",
@@ -432,3 +441,133 @@ def recovery_segment(
     )
     segments.append(hold_segment(segments[-1].last(), settle_s, ready_at, kind="recovery"))
     return segments, target
+
+
+HELD_M = 0.002
+"""How near [m] a foot's desired position must be to its recovery foothold
+for :func:`sliding_leg` to watch it (a foot still being put down is not)."""
+
+
+def sliding_leg(
+    measured: MeasuredState,
+    desired: DesiredState,
+    footholds: NDArray[np.float64],
+    limit: float,
+    loaded_n: float,
+) -> int | None:
+    """A foot sliding off its recovery foothold while the other three bear load, else None.
+
+    Watched: the feet the recovery holds on their ``footholds`` (4, 3) [m]
+    (desired supporting, within :data:`HELD_M` of them). The one farthest
+    beyond ``limit`` [m] counts if the other three each bear more than
+    ``loaded_n`` [N]: they can carry the trunk while it is put down again.
+    """
+    held = np.asarray(desired.support, dtype=bool) & (
+        np.linalg.norm(np.asarray(desired.feet) - footholds, axis=1) < HELD_M
+    )
+    off = np.where(held, np.linalg.norm(measured.feet - footholds, axis=1), 0.0)
+    leg = int(np.argmax(off))
+    if off[leg] <= limit:
+        return None
+    others = np.delete(np.asarray(measured.foot_forces)[:, 2], leg)
+    return leg if bool(np.all(others > loaded_n)) else None
+
+
+REPLANT_LIFT_M = 0.02
+"""Height [m] of the arch a re-planted foot swings through, over the higher
+of its two ends: enough to clear the rim of the face it slid down."""
+
+
+def replant_segments(
+    robot: Robot,
+    measured: MeasuredState,
+    leg: int,
+    target: NDArray[np.float64],
+    move_s: float,
+    settle_s: float,
+    ready_at: float,
+    margin: float,
+) -> list[Segment] | None:
+    """Lift foot ``leg`` where it stands and put it down on ``target`` (3,) [m]: a short step.
+
+    From the measured stance: the trunk moves until the centre of mass is
+    ``margin`` [m] inside the other three feet's triangle
+    (:func:`~roughwalk.trajectories.body_keyframes.pose_over_support`), the
+    foot swings to ``target`` through a :data:`REPLANT_LIFT_M` arch, the
+    trunk returns over the four feet (:func:`centred_fit`), and the robot
+    holds ``settle_s`` [s]. Each of the three motions takes ``move_s`` [s]
+    (longer if a joint needs it). None where the triangle cannot hold the
+    centre of mass with half that margin: lifting the foot would tip the
+    robot.
+    """
+    wb = WholeBody(robot)
+    feet = np.array(measured.feet, dtype=float)
+    others = [i for i in range(4) if i != leg]
+    rpy = matrix_to_rpy(measured.rotation)
+    shift = pose_over_support(wb, feet, others, margin, start=(measured.base_pos, rpy))
+    tri = feet[others, :2]
+    com = shift.com[:2]
+    inside = []
+    for k in range(3):
+        a, b = tri[k], tri[(k + 1) % 3]
+        c = tri[(k + 2) % 3]
+        edge = b - a
+        normal = np.array([-edge[1], edge[0]]) / max(float(np.linalg.norm(edge)), 1e-9)
+        if normal @ (c - a) < 0.0:
+            normal = -normal
+        inside.append(float(normal @ (com - a)))
+    if min(inside) < 0.5 * margin or not np.all(shift.reachable):
+        return None
+    k = 9
+    s2 = np.linspace(0.0, 1.0, k)[:, None]
+    four = np.ones(4, dtype=bool)
+    three = four.copy()
+    three[leg] = False
+    rpy1 = rpy + (shift.rpy - rpy + np.pi) % (2 * np.pi) - np.pi
+    segments = [
+        pose_segment(
+            robot,
+            (1.0 - s2) * measured.base_pos + s2 * shift.base_pos,
+            (1.0 - s2) * rpy + s2 * rpy1,
+            np.repeat(feet[None], k, axis=0),
+            four,
+            move_s,
+            "recovery",
+            ready_at,
+        )
+    ]
+    s1 = np.linspace(0.0, 1.0, k)
+    swing = np.repeat(feet[None], k, axis=0)
+    swing[:, leg] = (1.0 - s1)[:, None] * feet[leg] + s1[:, None] * np.asarray(target, dtype=float)
+    top = max(float(feet[leg, 2]), float(target[2])) + REPLANT_LIFT_M
+    lift = np.sin(np.pi * s1) * (top - ((1.0 - s1) * feet[leg, 2] + s1 * target[2]))
+    swing[:, leg, 2] += lift
+    segments.append(
+        pose_segment(
+            robot,
+            np.repeat(shift.base_pos[None], k, axis=0),
+            np.repeat(rpy1[None], k, axis=0),
+            swing,
+            three,
+            move_s,
+            "recovery",
+            ready_at,
+        )
+    )
+    after = swing[-1]
+    fit_pos, fit_rpy = centred_fit(robot, after)
+    fit_rpy = rpy1 + (fit_rpy - rpy1 + np.pi) % (2 * np.pi) - np.pi
+    segments.append(
+        pose_segment(
+            robot,
+            (1.0 - s2) * shift.base_pos + s2 * fit_pos,
+            (1.0 - s2) * rpy1 + s2 * fit_rpy,
+            np.repeat(after[None], k, axis=0),
+            four,
+            move_s,
+            "recovery",
+            ready_at,
+        )
+    )
+    segments.append(hold_segment(segments[-1].last(), settle_s, ready_at, kind="recovery"))
+    return segments

@@ -826,12 +826,26 @@ class TrajectoryConfig:
     sdf_resolution:
         Voxel size [m] of the terrain's signed distance field when one has to
         be built (5 mm as in the paper).
+    foot_centre:
+        How a planned contact point becomes the foot-sphere centre the
+        swing aims at and the stance holds: "normal", the contact plus the
+        foot radius along the terrain's normal at that one point (the
+        planner's own centre); "resting", where the sphere rests lowered
+        straight onto the contact's (x, y), over the whole foot's disc as
+        the planner's slope and rim checks judge it
+        (:func:`~roughwalk.trajectories.step_sequence._foot_centres`).
+        Session 17 (``bench_littledog.py --expansions 40000``): large rocks
+        seed 2 falls with "resting" (main 6.20 cm/s), seed 3 walks 6.06
+        (5.36). Touchdowns land within 0.9 cm of their plan with either,
+        so the aim is not what puts feet on steep faces (see
+        ``footstep.max_contact_slope``): "normal" stays.
     timing, zmp, swing, chomp, validity:
         The stages' settings.
     """
 
     control_rate_hz: float = 100.0
     sdf_resolution: float = 0.005
+    foot_centre: str = "normal"
     timing: TimingConfig = field(default_factory=TimingConfig)
     zmp: ZmpConfig = field(default_factory=ZmpConfig)
     swing: SwingConfig = field(default_factory=SwingConfig)
@@ -840,6 +854,10 @@ class TrajectoryConfig:
 
     def __post_init__(self) -> None:
         _check_positive(self, ("control_rate_hz", "sdf_resolution"), "trajectory")
+        if self.foot_centre not in ("normal", "resting"):
+            raise ConfigError(
+                f"trajectory.foot_centre must be 'normal' or 'resting', got {self.foot_centre!r}"
+            )
         for name, kind in (
             ("timing", TimingConfig),
             ("zmp", ZmpConfig),

@@ -169,7 +169,11 @@ class FootstepTrajectoryGenerator:
         if isinstance(plan, StepSequence):
             return plan
         return StepSequence.from_plan(
-            plan, self.wb, self.config.zmp.support_margin, terrain=self.terrain
+            plan,
+            self.wb,
+            self.config.zmp.support_margin,
+            terrain=self.terrain,
+            foot_centre=self.config.foot_centre,
         )
 
     @property

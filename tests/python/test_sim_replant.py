@@ -1,0 +1,147 @@
+"""After a recovery: a foot left on a steep face steps onto the nearest gentle foothold.
+
+``reflex.replant_max_slope`` (:func:`roughwalk.sim.recovery.replant_segments`,
+:func:`roughwalk.sim.foothold_snap.replant_targets`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import roughwalk as rw
+from roughwalk import _core
+from roughwalk.planning.foothold_safety import steep_footholds
+from roughwalk.sim.foothold_snap import replant_targets
+from roughwalk.sim.footstep_source import PlannerSource, planner_config
+from roughwalk.sim.joint_controller import JointController
+from roughwalk.sim.recovery import pose_segment, replant_segments, sliding_leg
+from roughwalk.sim.runner import Runner
+from roughwalk.sim.world import World
+from roughwalk.terrain import Terrain
+
+DX = 0.002
+
+
+def _standing(robot: rw.Robot, terrain: Terrain) -> tuple[Runner, JointController, object]:
+    st = robot.nominal_stance
+    base = np.array([0.5, 0.0, st.base_height])
+    quat = np.array([1.0, 0.0, 0.0, 0.0])
+    q, _ = robot.inverse_kinematics(st.feet + base, base, quat)
+    world = World(robot, terrain)
+    runner = Runner(world)
+    measured = runner.reset(q, base, quat)
+    return runner, JointController(world), measured
+
+
+def test_a_replanted_foot_steps_to_its_target_while_the_others_stay() -> None:
+    robot = rw.load_robot("littledog")
+    runner, controller, measured = _standing(robot, rw.load_terrain("flat"))
+    for _ in range(100):  # settle 0.2 s on four feet
+        still = pose_segment(
+            robot,
+            np.repeat(measured.base_pos[None], 2, axis=0),
+            np.zeros((2, 3)),
+            np.repeat(measured.feet[None], 2, axis=0),
+            np.ones(4, dtype=bool),
+            1e-3,
+            "hold",
+            0.0,
+        ).last()
+        measured = runner.step(controller.command(still.q, still, measured))
+    start = measured.feet.copy()
+    target = start[1] + [0.02, -0.01, 0.0]  # RF 2.2 cm forward and out
+    segments = replant_segments(robot, measured, 1, target, 0.25, 0.3, 0.0, 0.015)
+    assert segments is not None
+    t0 = measured.time
+    for k, segment in enumerate(segments):
+        begin = measured.time
+        while measured.time - begin < segment.duration:
+            desired = segment.sample(measured.time - begin)
+            measured = runner.step(controller.command(desired.q, desired, measured))
+            if k == 1 and measured.time - begin > 0.05:  # the swing, once the foot is off
+                carried = float(measured.foot_forces[[0, 2, 3], 2].sum())
+                assert carried > 0.8 * robot.mass * 9.81, (measured.time - begin, carried)
+            tilt = np.degrees(np.abs(rw.trajectories.euler.matrix_to_rpy(measured.rotation)[:2]))
+            assert np.all(tilt < 5.0), (measured.time - t0, tilt)
+    assert np.linalg.norm(measured.feet[1] - target) < 0.005
+    for leg in (0, 2, 3):
+        assert np.linalg.norm(measured.feet[leg, :2] - start[leg, :2]) < 0.003, leg
+
+
+def test_no_step_where_the_other_three_feet_cannot_hold_the_trunk() -> None:
+    robot = rw.load_robot("littledog")
+    _, _, measured = _standing(robot, rw.load_terrain("flat"))
+    # RF pulled back between the hind feet: RF, LH and RH make a sliver of
+    # a triangle that cannot hold the centre of mass 1.5 cm inside it.
+    feet = measured.feet.copy()
+    feet[1, :2] = 0.5 * (feet[2, :2] + feet[3, :2]) + [0.01, 0.0]
+    squeezed = type(measured)(**{**measured.__dict__, "feet": feet})
+    target = feet[0] + [0.02, 0.0, 0.0]
+    assert replant_segments(robot, squeezed, 0, target, 0.25, 0.3, 0.0, 0.015) is None
+
+
+@pytest.mark.skipif(
+    not hasattr(_core, "FootstepPlanner"), reason="the compiled core has no footstep planner"
+)
+def test_a_foot_on_a_flank_is_replanted_on_the_nearest_gentle_foothold() -> None:
+    """RF on a 50° ramp with a 40° limit: it moves; the feet on flat ground stay."""
+    robot = rw.load_robot("littledog")
+    x = np.arange(0.0, 0.8, DX)
+    y = np.arange(-0.3, 0.3, DX)
+    xx, _ = np.meshgrid(x, y, indexing="ij")
+    # A ramp rising 50° from x = 0.60 to 0.62, flat beyond: RF's foot stands on it.
+    h = np.clip((xx - 0.60) * np.tan(np.radians(50.0)), 0.0, 0.02 * np.tan(np.radians(50.0)))
+    terrain = Terrain(h, x0=0.0, y0=-0.3, dx=DX, dy=DX, name="flank")
+    source = PlannerSource(robot, terrain, expansions=10, config=planner_config(robot, 0.4, {}))
+    r = robot.foot_radius
+    steep = steep_footholds(terrain, r, np.radians(40.0))
+    feet = np.array([[0.45, 0.1, r], [0.61, -0.1, 0.012 + r], [0.25, 0.1, r], [0.25, -0.1, r]])
+    out = replant_targets(source.planner, terrain, feet, r, 0.025, steep)
+    assert [leg for leg, _ in out] == [1]
+    target = out[0][1]
+    assert np.linalg.norm(target[:2] - feet[1, :2]) <= 0.025 + 1e-9
+    i, j = round(target[0] / DX), round((target[1] + 0.3) / DX)
+    assert not steep[i, j]
+    # Not where the nearest gentle foothold is nearer than asked for.
+    assert replant_targets(source.planner, terrain, feet, r, 0.025, steep, 0.03) == []
+    # Its centre rests on the ground there: on it or, the flank within its disc, above it.
+    assert target[2] >= float(terrain.height(target[None, :2])[0]) + r - 1e-9
+
+
+def test_a_held_foot_sliding_off_its_recovery_foothold_is_caught_while_three_bear() -> None:
+    robot = rw.load_robot("littledog")
+    _, _, measured = _standing(robot, rw.load_terrain("flat"))
+    held = pose_segment(
+        robot,
+        np.repeat(measured.base_pos[None], 2, axis=0),
+        np.zeros((2, 3)),
+        np.repeat(measured.feet[None], 2, axis=0),
+        np.ones(4, dtype=bool),
+        1e-3,
+        "recovery",
+        0.0,
+    ).last()
+    footholds = measured.feet.copy()
+    loads = np.zeros((4, 3))
+    loads[:, 2] = 6.0
+
+    def slid(leg: int, by: float, forces: np.ndarray = loads) -> int | None:
+        feet = footholds.copy()
+        feet[leg, 0] -= by
+        now = dataclasses.replace(measured, feet=feet, foot_forces=forces)
+        return sliding_leg(now, held, footholds, 0.015, 1.0)
+
+    assert slid(1, 0.01) is None  # within the limit
+    assert slid(1, 0.02) == 1
+    unloaded = loads.copy()
+    unloaded[3, 2] = 0.0
+    assert slid(1, 0.02, unloaded) is None  # RH bears nothing: RF cannot be put down again
+    # A foot the recovery is still putting down (desired 5 mm off its foothold) is not watched.
+    lowering = dataclasses.replace(held, feet=held.feet + [[0.0, 0.0, 0.005]] * 4)
+    feet = footholds.copy()
+    feet[2, 0] -= 0.03
+    now = dataclasses.replace(measured, feet=feet, foot_forces=loads)
+    assert sliding_leg(now, lowering, footholds, 0.015, 1.0) is None
