@@ -55,10 +55,12 @@ class TrackingGains:
         pallet's far-corner tasks the trunk drifts sideways over the climb
         (two right feet carry it while both left feet swing): at 0.5 the
         left feet land at the edge of their reach, carry nothing, and the
-        robot rolls off the pallet's side. Session 17, the five plans of
-        held-out seeds 0 and 1 that fell at 0.5: 1.0 tracks three (seed 0
-        task 15 at 0 iterations, seed 1 tasks 18 and 20 at 5); 0.5 with a
-        0.2 m shift limit none of two.
+        robot rolls off the pallet's side. Session 17, ``bench_tracking
+        --tasks 30 --env double_pallet --init learned --durations fixed``,
+        1.0 against 0.5: seed 0 29/30 and 29/30 at 0 and 5 iterations
+        against 28/30 and 29/30, seed 1 27/30 and 29/30 against 27/30 and
+        27/30, seed 2 30/30 at 5 (as before); 0.5 with a 0.2 m shift limit
+        tracked none of two of the failing plans.
     max_foothold_shift_m:
         Largest foothold correction [m].
     max_base_feedback:
