@@ -49,7 +49,18 @@ class TrackingGains:
         correction a trotting base has in the direction its two feet cannot
         push. 0 lands exactly on the plan.
     foothold_position_gain:
-        Fraction of the base position error added to the footholds.
+        Fraction of the base position error added to the footholds. 1 lands
+        a swing foot where the plan puts it relative to the trunk as it is;
+        less keeps it nearer the planned spot in the world. On the double
+        pallet's far-corner tasks the trunk drifts sideways over the climb
+        (two right feet carry it while both left feet swing): at 0.5 the
+        left feet land at the edge of their reach, carry nothing, and the
+        robot rolls off the pallet's side. Session 17, ``bench_tracking
+        --tasks 30 --env double_pallet --init learned --durations fixed``,
+        1.0 against 0.5: seed 0 29/30 and 29/30 at 0 and 5 iterations
+        against 28/30 and 29/30, seed 1 27/30 and 29/30 against 27/30 and
+        27/30, seed 2 30/30 at 5 (as before); 0.5 with a 0.2 m shift limit
+        tracked none of two of the failing plans.
     max_foothold_shift_m:
         Largest foothold correction [m].
     max_base_feedback:
@@ -71,7 +82,7 @@ class TrackingGains:
     slip_gain_scale: float = 3.0
     slip_friction_scale: float = 0.5
     foothold_velocity_gain: float = 0.22
-    foothold_position_gain: float = 0.5
+    foothold_position_gain: float = 1.0
     max_foothold_shift_m: float = 0.12
     max_swing_feedback: float = 25.0
     max_base_feedback: float = 50.0
