@@ -608,20 +608,35 @@ class Executor:
         on and the source has a planner), else the foot's own position.
         """
         cfg = self.config.reflex
-        planner = getattr(self.source, "planner", None)
         foot = np.array(measured.feet[leg], dtype=float)
-        if cfg.replant_max_slope >= 0.5 * np.pi or cfg.replant_snap_m <= 0 or planner is None:
+        found = self._replant_planner()
+        if found is None:
             return foot
-        terrain = self.terrain_for_recovery
-        r = self.robot.foot_radius
-        if self._steep is None:
-            self._steep = steep_footholds(terrain, r, cfg.replant_max_slope)
+        planner, steep = found
+        terrain, r = self.terrain_for_recovery, self.robot.foot_radius
         for moved, target in replant_targets(
-            planner, terrain, measured.feet, r, cfg.replant_snap_m, self._steep
+            planner, terrain, measured.feet, r, cfg.replant_snap_m, steep
         ):
             if moved == leg:
                 return np.asarray(target, dtype=float)
         return foot
+
+    def _replant_planner(self) -> tuple[Any, np.ndarray] | None:
+        """The footstep planner re-planting uses and the too-steep cells; None when it is off.
+
+        Off unless ``reflex.replant_max_slope`` is below 90° and
+        ``reflex.replant_snap_m`` positive, and the source has a planner.
+        The too-steep cells' mask is built on first use.
+        """
+        cfg = self.config.reflex
+        planner = getattr(self.source, "planner", None)
+        if cfg.replant_max_slope >= 0.5 * np.pi or cfg.replant_snap_m <= 0 or planner is None:
+            return None
+        if self._steep is None:
+            self._steep = steep_footholds(
+                self.terrain_for_recovery, self.robot.foot_radius, cfg.replant_max_slope
+            )
+        return planner, self._steep
 
     def _recovery_slide(
         self, measured: MeasuredState, desired: DesiredState, now: float
@@ -660,15 +675,13 @@ class Executor:
         the footholds, if the other three can hold the trunk.
         """
         cfg = self.config.reflex
-        planner = getattr(self.source, "planner", None)
-        if cfg.replant_max_slope >= 0.5 * np.pi or cfg.replant_snap_m <= 0 or planner is None:
+        found = self._replant_planner()
+        if found is None:
             return False
-        terrain = self.terrain_for_recovery
-        r = self.robot.foot_radius
-        if self._steep is None:
-            self._steep = steep_footholds(terrain, r, cfg.replant_max_slope)
+        planner, steep = found
+        terrain, r = self.terrain_for_recovery, self.robot.foot_radius
         for leg, target in replant_targets(
-            planner, terrain, measured.feet, r, cfg.replant_snap_m, self._steep, cfg.replant_min_m
+            planner, terrain, measured.feet, r, cfg.replant_snap_m, steep, cfg.replant_min_m
         ):
             if leg in self._replanted:
                 continue
