@@ -84,11 +84,40 @@ def _task_space(env: str) -> tuple[str, list[Any] | None, str]:
     return space.terrain, [space], ""
 
 
-def held_out_tasks(env: str, n: int, seed: int = 0) -> tuple[str, list[Any], str]:
-    """``n`` held-out tasks of ``env`` (the test split of its task space)."""
+def held_out_tasks(
+    env: str,
+    n: int,
+    seed: int = 0,
+    refused: str = "redraw",
+    trajopt: tuple[tuple[str, str], ...] = (),
+) -> tuple[str, list[Any], str]:
+    """``n`` held-out tasks of ``env`` (the test split of its task space).
+
+    A start the solver refuses as input (``task_refusal``: a stance foot on
+    a pallet's edge, out of reach of a level base) measures the task sampler,
+    not the controller. With ``refused`` "redraw" such a task is drawn again
+    (:meth:`TaskSpace.draw`) and the note names it; with "count" it stays
+    and counts as a failure ("no trajectory"), as before session 18.
+    """
     terrain, spaces, note = _task_space(env)
     if spaces is not None:
-        return terrain, spaces[0].sample(n, seed=seed, split="test"), note
+        space = spaces[0]
+        if refused == "count":
+            return terrain, space.sample(n, seed=seed, split="test"), note
+        from roughwalk.learning.problem_spec import task_refusal
+
+        spec = _spec(env, False, trajopt)
+        tasks, notes = [], [note] if note else []
+        for i in range(n):
+            task, dropped = space.draw(
+                i, seed=seed, split="test", refuse=lambda t: task_refusal(spec, t)
+            )
+            tasks.append(task)
+            notes += [
+                f"task {i} redrawn: start {tuple(round(v, 3) for v in t.start)} refused ({why})"
+                for t, why in dropped
+            ]
+        return terrain, tasks, "; ".join(notes)
     import numpy as np
 
     from roughwalk.trajopt import Task
@@ -549,6 +578,13 @@ def main() -> None:
     parser.add_argument("--figure4", action="store_true", help="also run Figure 4's comparison")
     parser.add_argument("--seed", type=int, default=0, help="task sampling seed")
     parser.add_argument(
+        "--refused-starts",
+        choices=("redraw", "count"),
+        default="redraw",
+        help="a held-out start the solver refuses as input (no level stance): draw it again "
+        "(named in the notes) or count it as a failure",
+    )
+    parser.add_argument(
         "--tracking",
         action="append",
         default=[],
@@ -593,7 +629,7 @@ def main() -> None:
     durations = [d == "optimised" for d in args.durations.split(",") if d]
     jobs = []
     for env in [e for e in args.env.split(",") if e]:
-        terrain, tasks, note = held_out_tasks(env, n, args.seed)
+        terrain, tasks, note = held_out_tasks(env, n, args.seed, args.refused_starts, trajopt)
         if note:
             notes.append(f"{env}: {note}")
             print(notes[-1])
