@@ -598,7 +598,13 @@ class ReflexConfig:
         Board AE (bench large rocks seed 5, ``--expansions 40000``, the
         re-plant options): LH stepped 1 cm down a flank onto a stance no
         certificate holds, nor any within ``replan_nudge_m``, and the
-        re-plan failed. Acts only with one of those options on.
+        re-plan failed. Acts only with one of those options on. Session 18
+        (``bench_littledog.py --expansions 40000``, both re-plant options):
+        large rocks 0–7 5/8 at 5.63 cm/s as before, seed 5 now re-planned
+        from where LH stood (solved) but two reflexes later the trunk
+        touches the rocks at 5.65 s (main walks it at 2.67 after 5
+        reflexes); logs 0–5 3/6 (seeds 1, 2 roll over, 5's re-plan has no
+        certificate). The re-plant options stay off.
     recovery_slide_m, recovery_slides:
         During a recovery, no reflex watches the feet; with this, a foot
         the recovery holds on its foothold that slides more than
