@@ -13,9 +13,12 @@ import pytest
 
 import roughwalk as rw
 from roughwalk import _core
+from roughwalk.config import override
 from roughwalk.planning.foothold_safety import steep_footholds
+from roughwalk.sim.config import SimConfig
+from roughwalk.sim.executor import Executor
 from roughwalk.sim.foothold_snap import replant_targets
-from roughwalk.sim.footstep_source import PlannerSource, planner_config
+from roughwalk.sim.footstep_source import PlannerSource, PlanStart, planner_config
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.recovery import pose_segment, replant_segments, sliding_leg
 from roughwalk.sim.runner import Runner
@@ -145,3 +148,118 @@ def test_a_held_foot_sliding_off_its_recovery_foothold_is_caught_while_three_bea
     feet[2, 0] -= 0.03
     now = dataclasses.replace(measured, feet=feet, foot_forces=loads)
     assert sliding_leg(now, lowering, footholds, 0.015, 1.0) is None
+
+
+# Board AE, bench large rocks seed 5 (``bench_littledog.py --expansions 40000
+# --set reflex.replant_max_slope=0.6981317 --set reflex.recovery_slide_m=0.015``):
+# the recovery after the first reflex (1.37 s) settled at 2.18 s with LH on a
+# flank. Measured feet [m] (LF, RF, LH, RH) and trunk; the re-plant stepped LH
+# 1 cm down the flank, and the re-plan found no certificate there nor within 2 cm.
+AE_SEED5_FEET = np.array(
+    [
+        [0.39626, 0.39468, 0.02422],
+        [0.30975, 0.25087, 0.08821],
+        [0.19698, 0.35744, 0.05264],
+        [0.12974, 0.24191, 0.10239],
+    ]
+)
+AE_SEED5_TRUNK = (
+    np.array([0.2543, 0.31481, 0.2143]),
+    np.array([0.98058, -0.18393, 0.04581, 0.05029]),
+)
+AE_SEED5_GOAL = np.array([0.459, 0.3045])
+LH = 2
+
+
+def _recovered_on(
+    robot: rw.Robot,
+    terrain: Terrain,
+    feet: np.ndarray,
+    trunk: tuple[np.ndarray, np.ndarray],
+    goal: np.ndarray,
+    **settings: object,
+) -> tuple[Executor, object]:
+    """An executor whose recovery has settled with ``feet`` and ``trunk`` measured."""
+    source = PlannerSource(robot, terrain, expansions=10, config=planner_config(robot, 0.4, {}))
+    config = override(
+        SimConfig(),
+        {
+            "reflex.replant_max_slope": np.radians(40.0),
+            "reflex.recovery_slide_m": 0.015,
+            **settings,
+        },
+    )
+    executor = Executor(robot, terrain, source, config=config)
+    executor._goal = goal
+    executor._reflex_next_leg = 0
+    base, quat = trunk
+    q, _ = robot.inverse_kinematics(feet, base, quat)
+    measured = Runner(World(robot, terrain)).reset(q, base, quat)
+    return executor, dataclasses.replace(measured, feet=feet.copy())
+
+
+@pytest.mark.skipif(
+    not hasattr(_core, "FootstepPlanner"), reason="the compiled core has no footstep planner"
+)
+def test_a_foot_stays_where_the_stance_it_would_make_has_no_certificate(littledog_board) -> None:
+    robot = rw.load_robot("littledog")
+    terrain = littledog_board("AE")
+    executor, measured = _recovered_on(robot, terrain, AE_SEED5_FEET, AE_SEED5_TRUNK, AE_SEED5_GOAL)
+    # LH stands on a face, and a gentle foothold lies 1 cm down it ...
+    found = executor._replant_planner()
+    assert found is not None
+    targets = replant_targets(
+        found[0], terrain, AE_SEED5_FEET, robot.foot_radius, 0.025, found[1], 0.01
+    )
+    assert [leg for leg, _ in targets] == [LH]
+    # ... but no stance with LH there has a certificate: LH stays, nothing is queued.
+    assert not executor._replant(measured, 2.18)
+    assert not executor.buffer.queued
+    refused = executor.log.events_of("replant_refused")
+    assert [e["leg"] for e in refused] == ["LH"]
+    moved = AE_SEED5_FEET.copy()
+    moved[LH] = targets[0][1]
+    source = executor.source
+    assert not source.certifies(
+        PlanStart(feet=moved, next_leg=0, trunk=AE_SEED5_TRUNK), AE_SEED5_GOAL
+    )
+    # Where LH stands, the stance has one (from the measured trunk, as the re-plan asks).
+    kept = PlanStart(feet=AE_SEED5_FEET, next_leg=0, trunk=AE_SEED5_TRUNK)
+    assert source.certifies(kept, AE_SEED5_GOAL)
+    # A slid LH would be put down where it is, not there.
+    np.testing.assert_array_equal(executor._replant_target(measured, LH), AE_SEED5_FEET[LH])
+    # With the check off, the step the run took is queued again.
+    unchecked, measured = _recovered_on(
+        robot,
+        terrain,
+        AE_SEED5_FEET,
+        AE_SEED5_TRUNK,
+        AE_SEED5_GOAL,
+        **{"reflex.replant_certified": False},
+    )
+    assert unchecked._replant(measured, 2.18)
+    np.testing.assert_allclose(unchecked._replant_target(measured, LH), targets[0][1])
+
+
+@pytest.mark.skipif(
+    not hasattr(_core, "FootstepPlanner"), reason="the compiled core has no footstep planner"
+)
+def test_a_foot_on_a_flank_steps_where_the_stance_it_makes_is_certified() -> None:
+    """RF on a 50° ramp, the other feet on flat ground: the certified step is queued."""
+    robot = rw.load_robot("littledog")
+    x = np.arange(0.0, 0.8, DX)
+    y = np.arange(-0.3, 0.3, DX)
+    xx, _ = np.meshgrid(x, y, indexing="ij")
+    h = np.clip((xx - 0.60) * np.tan(np.radians(50.0)), 0.0, 0.02 * np.tan(np.radians(50.0)))
+    terrain = Terrain(h, x0=0.0, y0=-0.3, dx=DX, dy=DX, name="flank")
+    st = robot.nominal_stance
+    base = np.array([0.5, 0.0, st.base_height])
+    feet = st.feet + [0.5, 0.0, 0.0]
+    feet[1, :2] = (0.612, feet[1, 1])
+    feet[:, 2] = np.asarray(terrain.height(feet[:, :2])) + robot.foot_radius
+    executor, measured = _recovered_on(
+        robot, terrain, feet, (base, np.array([1.0, 0.0, 0.0, 0.0])), np.array([0.75, 0.0])
+    )
+    assert executor._replant(measured, 0.0)
+    assert [e["leg"] for e in executor.log.events_of("replant")] == ["RF"]
+    assert not executor.log.events_of("replant_refused")

@@ -589,6 +589,22 @@ class ReflexConfig:
         reflexes). With ``executor.start_max_slope`` 40° as well: large
         rocks 0–7 5/8 at 6.47 cm/s with 5 reflexes; held-out 8–15 and
         logs in ``docs/measurements.md``. Success is not better: off.
+    replant_certified:
+        A foot is re-planted (``replant_max_slope``, and a slid foot put
+        down again, ``recovery_slide_m``) only where the stance it makes
+        has a pose certificate, as the re-plan after it will ask (the
+        footstep planner's own routine, from the measured trunk with
+        ``replan_from_trunk``); otherwise the foot stays where it is.
+        Board AE (bench large rocks seed 5, ``--expansions 40000``, the
+        re-plant options): LH stepped 1 cm down a flank onto a stance no
+        certificate holds, nor any within ``replan_nudge_m``, and the
+        re-plan failed. Acts only with one of those options on. Session 18
+        (``bench_littledog.py --expansions 40000``, both re-plant options):
+        large rocks 0–7 5/8 at 5.63 cm/s as before, seed 5 now re-planned
+        from where LH stood (solved) but two reflexes later the trunk
+        touches the rocks at 5.65 s (main walks it at 2.67 after 5
+        reflexes); logs 0–5 3/6 (seeds 1, 2 roll over, 5's re-plan has no
+        certificate). The re-plant options stay off.
     recovery_slide_m, recovery_slides:
         During a recovery, no reflex watches the feet; with this, a foot
         the recovery holds on its foothold that slides more than
@@ -644,6 +660,7 @@ class ReflexConfig:
     replant_min_m: float = 0.01
     replant_s: float = 0.25
     replant_margin_m: float = 0.015
+    replant_certified: bool = True
     recovery_slide_m: float = 0.0
     recovery_slides: int = 2
     max_reflexes: int = 6

@@ -617,9 +617,30 @@ class Executor:
         for moved, target in replant_targets(
             planner, terrain, measured.feet, r, cfg.replant_snap_m, steep
         ):
-            if moved == leg:
+            if moved == leg and self._replant_certified(measured, leg, target):
                 return np.asarray(target, dtype=float)
         return foot
+
+    def _replant_certified(self, measured: MeasuredState, leg: int, target: np.ndarray) -> bool:
+        """Whether the stance a re-plant makes (``leg`` at ``target`` [m]) has a pose certificate.
+
+        See ``reflex.replant_certified``: asked of the source's planner as
+        the re-plan after it will ask (from the measured trunk with
+        ``reflex.replan_from_trunk``, the leg due to lift first). True when
+        the check is off or the source cannot certify.
+        """
+        certifies = getattr(self.source, "certifies", None)
+        if not self.config.reflex.replant_certified or certifies is None:
+            return True
+        feet = np.array(measured.feet, dtype=float)
+        feet[leg] = target
+        trunk = (measured.base_pos.copy(), measured.base_quat.copy())
+        start = PlanStart(
+            feet=feet,
+            next_leg=getattr(self, "_reflex_next_leg", None),
+            trunk=trunk if self.config.reflex.replan_from_trunk else None,
+        )
+        return bool(certifies(start, self._goal))
 
     def _replant_planner(self) -> tuple[Any, np.ndarray] | None:
         """The footstep planner re-planting uses and the too-steep cells; None when it is off.
@@ -697,6 +718,16 @@ class Executor:
                 cfg.replant_margin_m,
             )
             if segments is None:
+                continue
+            if not self._replant_certified(measured, leg, target):
+                self.log.event(
+                    now,
+                    "replant_refused",
+                    leg=LEG_NAMES[leg],
+                    foot=measured.feet[leg],
+                    target=target,
+                    reason="no pose certificate for the stance it makes",
+                )
                 continue
             self._settle_deadline = None
             for segment in segments:

@@ -328,6 +328,28 @@ class PlannerSource:
         start_clearance = None if result.initial_pose is None else result.initial_pose.clearance
         return PlanAttempt(result, result.status, "", wall, start_clearance)
 
+    def certifies(self, start: PlanStart, goal: NDArray[np.float64]) -> bool:
+        """Whether a re-plan from the feet of ``start`` would find its start stance certified.
+
+        The stance as :meth:`plan` would start from it (feet off the
+        footholds snapped, ``start.refused`` kept out of, ``start.next_leg``
+        to lift first, the certificate searched from ``start.trunk`` where
+        one is given) and the planner's own pose-certificate routine, with
+        no search after it: what a recovery asks before it moves a foot
+        (``reflex.replant_certified``). Outcomes are cached by the planner
+        as any plan's are.
+        """
+        if start.feet is None:
+            raise InvalidArgumentError("certifies needs a start from the feet (feet=)")
+        leg = LEG_NAMES[start.next_leg] if start.next_leg is not None else "LH"
+        planner = self._refusing(start.refused)
+        feet, _ = snap_to_footholds(planner, self.terrain, start.feet, SNAP_RADIUS_M)
+        g = np.asarray(goal, dtype=float)[:2]
+        result = planner.replan(feet, leg, goal=g, time_limit=None, expansions=0, trunk=start.trunk)
+        # With no search the result carries no certificate; "invalid_input"
+        # is what a start stance without one (or a foot on no foothold) gives.
+        return bool(result.status != "invalid_input")
+
     def _refusing(self, refused: tuple[tuple[int, float, float, float], ...]) -> Any:
         """The planner, or one that keeps every leg out of the discs ``refused`` has ever named.
 
