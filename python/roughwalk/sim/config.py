@@ -526,6 +526,19 @@ class ReflexConfig:
         are chaotic, and two seeds do not tell the better setting. On by
         default since session 12, with the measured timing (see
         ``foot_force_per_leg``).
+    loaded_window_s:
+        A foot that bore load (over 1 N) at any tick within this long [s]
+        before the reflex counts as loaded for the recovery: it is not
+        put down like a lifted foot, and it bears the trunk while the
+        others go down (0: only the load at the reflex's tick counts).
+        Feet on rock faces chatter: on board AE (bench large rocks seed 6,
+        ``--expansions 40000`` with ``executor.start_max_slope`` 40°) RH
+        bore 6.4 N at 0.912 s and nothing for the 34 ms to the foot-force
+        reflex (0.946 s, LF swinging); put down as a lifted foot, with
+        only RF and LH bearing, the trunk rolled −13° → −20° over the
+        RF–LH diagonal, LF struck at 78 N and the robot bounced over to
+        the right (34° at 1.43 s). With 0.05 RH stays and bears, and the
+        run reaches the goal (3.95 cm/s, 2 reflexes).
     replan_nudge_m:
         Where the stance the feet stand on after a recovery has no pose
         certificate (nor, within 2.5 cm, the one they were headed for), the
@@ -636,6 +649,7 @@ class ReflexConfig:
     capture_max_m: float = 0.04
     replan_budget_s: float = 2.0
     standing_bear: bool = True
+    loaded_window_s: float = 0.0
     replan_nudge_m: float = 0.02
     replan_from_trunk: bool = True
     replan_nudge_any_leg: bool = True
@@ -675,6 +689,7 @@ class ReflexConfig:
                 "persist_s",
                 "settle_s",
                 "capture_max_m",
+                "loaded_window_s",
                 "replan_nudge_m",
                 "settle_max_s",
                 "replant_snap_m",
