@@ -111,8 +111,10 @@ def test_a_foot_loaded_a_few_ticks_before_the_reflex_counts_as_loaded() -> None:
     np.testing.assert_array_equal(recently_loaded(last, 0.946, 0.03), [False, True, True, False])
 
 
-def recovery_of_a_chattering_foot(standing, window_s: float) -> tuple[dict, np.ndarray]:
-    """The recovery's event and footholds where RH, 5 mm up, bore load 34 ms before the reflex."""
+def recovery_of_a_chattering_foot(
+    standing, window_s: float, rh_up_m: float = 0.005
+) -> tuple[dict, np.ndarray]:
+    """The recovery's event and footholds where RH, ``rh_up_m`` up, bore load 34 ms before."""
     robot, terrain, measured = standing
     config = override(SimConfig(), {"reflex.loaded_window_s": window_s})
     executor = Executor(robot, terrain, CrawlSource(robot, terrain), config=config)
@@ -120,7 +122,7 @@ def recovery_of_a_chattering_foot(standing, window_s: float) -> tuple[dict, np.n
     forces[[1, 2], 2] = 12.0  # RF and LH loaded at the reflex, LF swinging
     feet = measured.feet.copy()
     feet[0, 2] += 0.03  # LF in the air
-    feet[3, 2] += 0.005  # RH bounced off its foothold (a rock face)
+    feet[3, 2] += rh_up_m  # RH bounced off its foothold (a rock face)
     at_reflex = dataclasses.replace(measured, foot_forces=forces, feet=feet)
     now = float(measured.time)
     executor._last_loaded[:] = [-np.inf, now, now, now - 0.034]
@@ -139,6 +141,10 @@ def test_a_foot_that_bore_load_within_the_window_is_not_put_down_like_a_lifted_o
     assert footholds[0, 2] < measured.feet[0, 2] + 0.01  # LF goes down
     # Without the window RH is taken for lifted and lowered (as on main).
     event, footholds = recovery_of_a_chattering_foot(standing, 0.0)
+    assert event["feet_down"] == [False, True, True, False]
+    assert footholds[3, 2] < measured.feet[3, 2] + 0.001
+    # A foot lifting off 2 cm up (bench logs seed 1's RF at 1.50 s) is put down, window or not.
+    event, footholds = recovery_of_a_chattering_foot(standing, 0.05, rh_up_m=0.02)
     assert event["feet_down"] == [False, True, True, False]
     assert footholds[3, 2] < measured.feet[3, 2] + 0.001
 

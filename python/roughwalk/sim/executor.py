@@ -42,6 +42,7 @@ from roughwalk.sim.outcome import Outcome, OutcomeMonitor
 from roughwalk.sim.recovery import (
     blend_segment,
     hold_segment,
+    near_ground,
     pose_segment,
     recently_loaded,
     recovery_segment,
@@ -567,7 +568,11 @@ class Executor:
             self._replanted = set()
             self._slides = 0
             self._reflex_planned_feet = np.array(planned, dtype=float)
-        in_contact = recently_loaded(self._last_loaded, now, cfg.loaded_window_s)
+        # A foot that bore load a few ticks ago and still stands counts as loaded.
+        in_contact = recently_loaded(self._last_loaded, now, 0.0) | (
+            recently_loaded(self._last_loaded, now, cfg.loaded_window_s)
+            & near_ground(self.robot, self.terrain_for_recovery, measured.feet)
+        )
         bearing = (
             in_contact
             | standing_feet(

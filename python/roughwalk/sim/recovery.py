@@ -55,6 +55,7 @@ __all__ = [
     "min_jerk",
     "off_edge",
     "standing_feet",
+    "near_ground",
     "recently_loaded",
     "settled",
 ]
@@ -322,9 +323,14 @@ def standing_feet(
     than ``loaded_n`` [N].
     """
     loaded = measured.foot_forces[:, 2] > loaded_n
-    ground = terrain.height(measured.feet[:, :2])
-    low = measured.feet[:, 2] - ground - robot.foot_radius < STANDING_M
+    low = near_ground(robot, terrain, measured.feet)
     return np.asarray(loaded | (np.asarray(support, dtype=bool) & low), dtype=bool)
+
+
+def near_ground(robot: Robot, terrain: Terrain, feet: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """The feet (4, 3) [m] less :data:`STANDING_M` above the ground (centre less radius)."""
+    ground = terrain.height(feet[:, :2])
+    return np.asarray(feet[:, 2] - ground - robot.foot_radius < STANDING_M, dtype=bool)
 
 
 def recently_loaded(
