@@ -546,7 +546,10 @@ class ReflexConfig:
         3.69 cm/s after 3 reflexes): without the ground check its RF,
         lifting off 2 cm up after a bounce, was held in the air (pitched
         35° at 3.72 s); with it the trunk touches the terrain at 6.32 s
-        after 5 reflexes.
+        after 5 reflexes. Large rocks seeds 0–11 (``bench_littledog.py
+        --expansions 40000 --seeds 12 --classes large_rocks``, session 18):
+        7/12 at 5.50 cm/s → 9/12 at 5.34 (6 and 11 rescued, 9 4.21 → 5.41,
+        3 5.36 → 3.86); the 1 N·s side pushes the same push times as main.
     replan_nudge_m:
         Where the stance the feet stand on after a recovery has no pose
         certificate (nor, within 2.5 cm, the one they were headed for), the
