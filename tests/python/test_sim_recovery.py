@@ -8,11 +8,14 @@ import numpy as np
 import pytest
 
 import roughwalk
-from roughwalk.sim.config import ReflexConfig
-from roughwalk.sim.executor import nudged_stances
+from roughwalk.config import override
+from roughwalk.sim import CrawlSource
+from roughwalk.sim.config import ReflexConfig, SimConfig
+from roughwalk.sim.executor import Executor, nudged_stances
 from roughwalk.sim.recovery import (
     centred_fit,
     off_edge,
+    recently_loaded,
     recovery_segment,
     settled,
     standing_feet,
@@ -98,6 +101,52 @@ def test_a_supporting_foot_on_the_ground_stands_though_it_bears_no_load_this_ins
     lifted = dataclasses.replace(at_reflex, feet=feet)
     down = standing_feet(robot, terrain, lifted, support, 1.0)
     np.testing.assert_array_equal(down, [True, True, False, False])
+
+
+def test_a_foot_loaded_a_few_ticks_before_the_reflex_counts_as_loaded() -> None:
+    """Board AE, bench large rocks seed 6: RH bore 6.4 N at 0.912 s, none to the reflex at 0.946."""
+    last = np.array([-np.inf, 0.946, 0.946, 0.912])  # LF swinging, RF and LH loaded now
+    np.testing.assert_array_equal(recently_loaded(last, 0.946, 0.0), [False, True, True, False])
+    np.testing.assert_array_equal(recently_loaded(last, 0.946, 0.05), [False, True, True, True])
+    np.testing.assert_array_equal(recently_loaded(last, 0.946, 0.03), [False, True, True, False])
+
+
+def recovery_of_a_chattering_foot(
+    standing, window_s: float, rh_up_m: float = 0.005
+) -> tuple[dict, np.ndarray]:
+    """The recovery's event and footholds where RH, ``rh_up_m`` up, bore load 34 ms before."""
+    robot, terrain, measured = standing
+    config = override(SimConfig(), {"reflex.loaded_window_s": window_s})
+    executor = Executor(robot, terrain, CrawlSource(robot, terrain), config=config)
+    forces = np.zeros((4, 3))
+    forces[[1, 2], 2] = 12.0  # RF and LH loaded at the reflex, LF swinging
+    feet = measured.feet.copy()
+    feet[0, 2] += 0.03  # LF in the air
+    feet[3, 2] += rh_up_m  # RH bounced off its foothold (a rock face)
+    at_reflex = dataclasses.replace(measured, foot_forces=forces, feet=feet)
+    now = float(measured.time)
+    executor._last_loaded[:] = [-np.inf, now, now, now - 0.034]
+    executor._start_recovery(at_reflex, executor._standing(at_reflex), now)
+    event = executor.log.events_of("recovery")[-1]
+    return event, np.asarray(event["footholds"])
+
+
+def test_a_foot_that_bore_load_within_the_window_is_not_put_down_like_a_lifted_one(
+    standing,
+) -> None:
+    _, _, measured = standing
+    event, footholds = recovery_of_a_chattering_foot(standing, 0.05)
+    assert event["feet_down"] == [False, True, True, True]
+    assert footholds[3, 2] == pytest.approx(measured.feet[3, 2] + 0.005)  # RH stays
+    assert footholds[0, 2] < measured.feet[0, 2] + 0.01  # LF goes down
+    # Without the window RH is taken for lifted and lowered (as on main).
+    event, footholds = recovery_of_a_chattering_foot(standing, 0.0)
+    assert event["feet_down"] == [False, True, True, False]
+    assert footholds[3, 2] < measured.feet[3, 2] + 0.001
+    # A foot lifting off 2 cm up (bench logs seed 1's RF at 1.50 s) is put down, window or not.
+    event, footholds = recovery_of_a_chattering_foot(standing, 0.05, rh_up_m=0.02)
+    assert event["feet_down"] == [False, True, True, False]
+    assert footholds[3, 2] < measured.feet[3, 2] + 0.001
 
 
 def test_a_foot_caught_over_a_steps_edge_goes_down_on_the_step_not_on_its_corner(standing) -> None:

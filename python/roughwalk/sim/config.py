@@ -526,6 +526,30 @@ class ReflexConfig:
         are chaotic, and two seeds do not tell the better setting. On by
         default since session 12, with the measured timing (see
         ``foot_force_per_leg``).
+    loaded_window_s:
+        A foot that bore load (over 1 N) at any tick within this long [s]
+        before the reflex, and is still within 1 cm of the ground, counts
+        as loaded for the recovery: it stays where it is rather than being
+        put down on its planned foothold like a lifted foot (0: only the
+        load at the reflex's tick counts). Feet on rock faces chatter: on
+        board AE (bench large rocks seed 6, ``--expansions 40000`` with
+        ``executor.start_max_slope`` 40°) RH bore 6.4 N at 0.912 s and
+        nothing for the 34 ms to the foot-force reflex (0.946 s, LF
+        swinging, RH 2.6 mm over the ground). It bore the trunk either way
+        (``standing_bear``); put down, it moved the few millimetres to its
+        planned foothold, the trunk rolled −13° → −20° over the RF–LH
+        diagonal, LF struck at 78 N and the robot bounced over to the right
+        (34° at 1.43 s); held, the run reaches the goal (3.95 cm/s, 2
+        reflexes). A difference of millimetres: the outcome there is
+        chaotic rather than this option's doing. Off: at 0.05 bench logs
+        seed 1 (``--expansions 40000``) falls (main reaches the goal at
+        3.69 cm/s after 3 reflexes): without the ground check its RF,
+        lifting off 2 cm up after a bounce, was held in the air (pitched
+        35° at 3.72 s); with it the trunk touches the terrain at 6.32 s
+        after 5 reflexes. Large rocks seeds 0–11 (``bench_littledog.py
+        --expansions 40000 --seeds 12 --classes large_rocks``, session 18):
+        7/12 at 5.50 cm/s → 9/12 at 5.34 (6 and 11 rescued, 9 4.21 → 5.41,
+        3 5.36 → 3.86); the 1 N·s side pushes the same push times as main.
     replan_nudge_m:
         Where the stance the feet stand on after a recovery has no pose
         certificate (nor, within 2.5 cm, the one they were headed for), the
@@ -652,6 +676,7 @@ class ReflexConfig:
     capture_max_m: float = 0.04
     replan_budget_s: float = 2.0
     standing_bear: bool = True
+    loaded_window_s: float = 0.0
     replan_nudge_m: float = 0.02
     replan_from_trunk: bool = True
     replan_nudge_any_leg: bool = True
@@ -692,6 +717,7 @@ class ReflexConfig:
                 "persist_s",
                 "settle_s",
                 "capture_max_m",
+                "loaded_window_s",
                 "replan_nudge_m",
                 "settle_max_s",
                 "replant_snap_m",

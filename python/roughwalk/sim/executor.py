@@ -42,7 +42,9 @@ from roughwalk.sim.outcome import Outcome, OutcomeMonitor
 from roughwalk.sim.recovery import (
     blend_segment,
     hold_segment,
+    near_ground,
     pose_segment,
+    recently_loaded,
     recovery_segment,
     replant_segments,
     settled,
@@ -198,6 +200,8 @@ class Executor:
         self._slides = 0
         self._slide_since: float | None = None
         self._recovery_footholds = np.zeros((4, 3))
+        # When each foot last bore load [s] (``reflex.loaded_window_s``).
+        self._last_loaded = np.full(4, -np.inf)
 
     # ---- planning -------------------------------------------------------------------
 
@@ -354,6 +358,7 @@ class Executor:
             # The trunk's target moved by the CoP stabiliser's shift: what the
             # integrators hold and the reflexes judge.
             steered = self.stabilizer.update(desired, measured)
+            self._last_loaded[measured.foot_forces[:, 2] > _LOADED_N] = now
             slid = self._recovery_slide(measured, desired, now) if mode == "recovery" else None
             if slid is not None:
                 log.event(now, "recovery_slide", leg=LEG_NAMES[slid], foot=measured.feet[slid])
@@ -563,9 +568,14 @@ class Executor:
             self._replanted = set()
             self._slides = 0
             self._reflex_planned_feet = np.array(planned, dtype=float)
-        in_contact = measured.foot_forces[:, 2] > _LOADED_N
+        # A foot that bore load a few ticks ago and still stands counts as loaded.
+        in_contact = recently_loaded(self._last_loaded, now, 0.0) | (
+            recently_loaded(self._last_loaded, now, cfg.loaded_window_s)
+            & near_ground(self.robot, self.terrain_for_recovery, measured.feet)
+        )
         bearing = (
-            standing_feet(
+            in_contact
+            | standing_feet(
                 self.robot, self.terrain_for_recovery, measured, desired.support, _LOADED_N
             )
             if cfg.standing_bear

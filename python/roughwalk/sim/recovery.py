@@ -55,6 +55,8 @@ __all__ = [
     "min_jerk",
     "off_edge",
     "standing_feet",
+    "near_ground",
+    "recently_loaded",
     "settled",
 ]
 
@@ -321,9 +323,30 @@ def standing_feet(
     than ``loaded_n`` [N].
     """
     loaded = measured.foot_forces[:, 2] > loaded_n
-    ground = terrain.height(measured.feet[:, :2])
-    low = measured.feet[:, 2] - ground - robot.foot_radius < STANDING_M
+    low = near_ground(robot, terrain, measured.feet)
     return np.asarray(loaded | (np.asarray(support, dtype=bool) & low), dtype=bool)
+
+
+def near_ground(robot: Robot, terrain: Terrain, feet: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """The feet (4, 3) [m] less :data:`STANDING_M` above the ground (centre less radius)."""
+    ground = terrain.height(feet[:, :2])
+    return np.asarray(feet[:, 2] - ground - robot.foot_radius < STANDING_M, dtype=bool)
+
+
+def recently_loaded(
+    last_loaded_s: NDArray[np.float64], now: float, window_s: float
+) -> NDArray[np.bool_]:
+    """The feet (4,) that bore load within ``window_s`` [s] before ``now`` [s].
+
+    ``last_loaded_s`` (4,) [s]: when each foot last bore load (−∞: never).
+    A foot chattering on a rock face bears load every few ticks and none
+    in between (board AE: RH alternated 0 and 15–20 N every 8 ms, bench
+    large rocks seed 0; RH bore nothing for the 34 ms before seed 6's
+    reflex); at a reflex it stands as much as a foot loaded at that tick.
+    ``window_s`` 0: only a foot loaded at ``now``.
+    """
+    age = now - np.asarray(last_loaded_s, dtype=float)
+    return np.asarray(age <= window_s + 1e-9, dtype=bool)
 
 
 def settled(measured: MeasuredState, rate_rad_s: float, loaded_feet: int, loaded_n: float) -> bool:
