@@ -290,6 +290,15 @@ class TimingConfig:
     settle_s:
         After the last step, four feet down while the centre of mass comes to
         rest over the final pose [s].
+    stretch_shift:
+        Whether the re-timing of a swing whose initial trajectory breaks a
+        joint's velocity limit (the generator's ``_retimed``: the step
+        lengthened by the swing leg's peak speed over its limit) lengthens
+        the shift as well (True, default), or only the swing (False). Only
+        the swing leg's airborne speed is measured there, so the shift's
+        share of the stretch is time the limit does not ask for (large
+        rocks seed 0: 0.06 s of its 0.30 s stretch); a longer shift gives
+        the preview controller more time to move the ZMP, though.
 
     Session 10: where a run's clock goes, and the shift defaults
     (``min_shift_s`` 0.2 → 0.1, ``first_shift_s`` 0 → 0.2,
@@ -347,6 +356,7 @@ class TimingConfig:
     max_step_s: float = 4.0
     settle_s: float = 0.8
     swing_trunk: str = "moving"
+    stretch_shift: bool = True
 
     def shift_floor(self, travel: float) -> float:
         """Shortest shift phase [s] for a ZMP travel of ``travel`` [m]."""
@@ -578,6 +588,17 @@ class SwingConfig:
         (``bench_push_recovery.py --from 1.6 --to 3.2``) at 0.005: left 8/9,
         right 7/9 (8/9, 8/9 off), hence still off. With the defaults since
         session 15 (the fast options everywhere) it changes nothing.
+    law_trunk:
+        The trunk under which the ``"joint"`` time law paces a step's swing
+        (and picks its path and law by the least time): ``"swing_pose"``
+        (default), the pose held through the swing, where a step down a
+        rock misses its target by 3–6 cm (the trunk reaches it only by
+        lowering into the landing pose) and the law falls back to
+        ``"even"``; ``"moving"``, the initial trajectory's trunk from
+        lift-off to touchdown (:func:`~roughwalk.trajectories.initial_trajectory.moving_trunk_leg`),
+        so the limiting joint runs near its limit along the whole swing
+        rather than at one point of it. Only the initial trajectory's swing
+        changes; the nominal timing still uses the swing pose.
     """
 
     lift_height: float = 0.03
@@ -590,9 +611,14 @@ class SwingConfig:
     path: str = "joint"
     lift_off_reach: bool = True
     fast_swing_relief: float = 0.0
+    law_trunk: str = "swing_pose"
 
     def __post_init__(self) -> None:
         _check_nonnegative(self, ("lift_height", "clearance", "fast_swing_relief"), "swing")
+        if self.law_trunk not in ("swing_pose", "moving"):
+            raise ConfigError(
+                f"swing.law_trunk must be 'swing_pose' or 'moving', got {self.law_trunk!r}"
+            )
         if self.path not in ("cartesian", "joint"):
             raise ConfigError(f"swing.path must be 'cartesian' or 'joint', got {self.path!r}")
         if not (math.isfinite(self.lift_fraction) and 0 <= self.lift_fraction < 0.5):
