@@ -81,6 +81,32 @@ def test_moving_trunk_leg_follows_the_trunk(littledog: rw.Robot) -> None:
     np.testing.assert_allclose(q[0], pose.leg_angles(wb, 0)(path[:1])[0], atol=1e-9)
 
 
+def test_a_rise_gate_leaves_level_swings_as_they_were(littledog: rw.Robot) -> None:
+    """With ``law_trunk_rise`` 1 cm a flat crawl is the same trajectory as under the swing pose.
+
+    So the flat-ground push sweeps walk as before; over the block the climbs
+    (5 cm) are still paced under the moving trunk.
+    """
+    terrain = rw.load_terrain("flat:length=1.2,width=0.5")
+    plan = straight_crawl_plan(littledog, terrain, (0.3, 0.0), steps=4, stride=0.07)
+    made = {}
+    for law, rise in (("swing_pose", 0.0), ("moving", 0.01), ("moving", 0.0)):
+        config = rw.trajectories.trajectory_config(
+            **{"swing.law_trunk": law, "swing.law_trunk_rise": rise}
+        )
+        gen = FootstepTrajectoryGenerator(littledog, terrain, config=config)
+        made[law, rise] = list(gen.iter_steps(gen.prepare(plan)))
+    for a, b in zip(made["swing_pose", 0.0], made["moving", 0.01], strict=True):
+        np.testing.assert_array_equal(a.q, b.q)
+    # Ungated, the moving trunk does change level swings (what the gate is for).
+    assert any(
+        a.q.shape != b.q.shape or not np.array_equal(a.q, b.q)
+        for a, b in zip(made["swing_pose", 0.0], made["moving", 0.0], strict=True)
+    )
+
+
 def test_law_trunk_is_checked() -> None:
     with pytest.raises(ConfigError, match="law_trunk"):
         SwingConfig(law_trunk="still")
+    with pytest.raises(ConfigError, match="law_trunk_rise"):
+        SwingConfig(law_trunk_rise=-0.01)

@@ -298,7 +298,15 @@ class TimingConfig:
         the swing leg's airborne speed is measured there, so the shift's
         share of the stretch is time the limit does not ask for (large
         rocks seed 0: 0.06 s of its 0.30 s stretch); a longer shift gives
-        the preview controller more time to move the ZMP, though.
+        the preview controller more time to move the ZMP, though. Off
+        (``bench_littledog.py --expansions 40000 --classes large_rocks``):
+        seed 0 7.15 → 7.30 cm/s, but seed 3 (5.36 cm/s after one reflex)
+        fails (its re-plan after the reflex finds no start certificate);
+        with ``swing.law_trunk`` "moving" as well, large rocks seeds 0–7
+        6/8 at 6.42 cm/s (main 5/8 at 5.30; seed 3 lost, 4 and 6 gained)
+        and the 1 N·s right push (``bench_push_recovery.py --from 1.6 --to
+        3.2 --direction -90``) 6/9 (main 7/9: 2.0 s falls too), left 8/9
+        as main. Hence on.
 
     Session 10: where a run's clock goes, and the shift defaults
     (``min_shift_s`` 0.2 → 0.1, ``first_shift_s`` 0 → 0.2,
@@ -599,6 +607,11 @@ class SwingConfig:
         so the limiting joint runs near its limit along the whole swing
         rather than at one point of it. Only the initial trajectory's swing
         changes; the nominal timing still uses the swing pose.
+    law_trunk_rise:
+        With ``law_trunk`` "moving", only swings whose target lies at least
+        this far [m] above or below their start are paced under the moving
+        trunk (the steps up and down rocks it is for); the others keep the
+        swing pose. 0: every swing. On level ground nothing changes then.
     """
 
     lift_height: float = 0.03
@@ -612,9 +625,12 @@ class SwingConfig:
     lift_off_reach: bool = True
     fast_swing_relief: float = 0.0
     law_trunk: str = "swing_pose"
+    law_trunk_rise: float = 0.0
 
     def __post_init__(self) -> None:
-        _check_nonnegative(self, ("lift_height", "clearance", "fast_swing_relief"), "swing")
+        _check_nonnegative(
+            self, ("lift_height", "clearance", "fast_swing_relief", "law_trunk_rise"), "swing"
+        )
         if self.law_trunk not in ("swing_pose", "moving"):
             raise ConfigError(
                 f"swing.law_trunk must be 'swing_pose' or 'moving', got {self.law_trunk!r}"

@@ -352,7 +352,8 @@ def build_initial_trajectory(
     body[:, 3:] = pose[:, 1:4]
 
     law_legs = None
-    if swing_config.law_trunk == "moving":
+    rise = abs(float(step.target[2] - step.start[2]))
+    if swing_config.law_trunk == "moving" and rise >= swing_config.law_trunk_rise:
         law_legs = moving_trunk_leg(wb, swing_pose, body[lift_off : touchdown + 1], step.leg)
     swing = SwingSpline.plan(
         step.start,
