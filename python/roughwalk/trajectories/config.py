@@ -606,12 +606,26 @@ class SwingConfig:
         lift-off to touchdown (:func:`~roughwalk.trajectories.initial_trajectory.moving_trunk_leg`),
         so the limiting joint runs near its limit along the whole swing
         rather than at one point of it. Only the initial trajectory's swing
-        changes; the nominal timing still uses the swing pose.
+        changes; the nominal timing still uses the swing pose. Large rocks
+        seeds 0–7 (``bench_littledog.py --expansions 40000 --classes
+        large_rocks``), main 5/8 at 5.30 cm/s → "moving" 7/8 at 6.21 (seed
+        0 7.15 → 7.91 with no reflex either way, seed 1 5.10 → 7.23 with
+        its reflex gone, seed 3 5.36 → 4.81 with two); but the 1 N·s right
+        push (``bench_push_recovery.py --from 1.6 --to 3.2 --direction
+        -90``) survives 6 of 9 against 7 (2.0 s, in LF's swing on level
+        ground, rolls over), hence off; see ``law_trunk_rise``.
     law_trunk_rise:
         With ``law_trunk`` "moving", only swings whose target lies at least
         this far [m] above or below their start are paced under the moving
         trunk (the steps up and down rocks it is for); the others keep the
         swing pose. 0: every swing. On level ground nothing changes then.
+        At 0.01 with "moving" (``bench_littledog.py --expansions 40000``):
+        large rocks seeds 0–7 6/8 at 5.93 cm/s (main 5/8 at 5.30; seed 6
+        gained), the other five classes 2/2 each and faster on seeds 0–1
+        (round rocks 7.54 → 8.41, sloped rocks 8.50 → 9.31, gap 7.60 →
+        7.62, barrier 8.52 → 8.64, steps 8.63 → 8.98), but logs seeds 0–5
+        lose seed 1 (main 3.69 cm/s after its reflexes; 6 reflexes, given
+        up) and gain seed 5: 4/6 at 8.08 against 7.71. Hence off.
     """
 
     lift_height: float = 0.03
