@@ -213,3 +213,33 @@ def test_the_swing_pass_stops_when_its_leg_is_clear_though_the_rest_is_not(
     after = capsule_clearances(gen.wb, gen.sdf, state.q, state.body[:, :3], state.rotation)
     assert after[:, swing_links].min() >= cfg.validity.min_clearance - 1e-9
     assert outcome.iterations < cfg.chomp.max_iterations
+
+
+def test_without_stretch_shift_only_the_swing_is_lengthened(littledog: rw.Robot) -> None:
+    """``timing.stretch_shift`` off: the hurried swings grow as before, their shifts do not.
+
+    The re-timing measures only the swing leg in the air, so the shift's share
+    of the stretch is time no limit asked for; the steps stay valid (the ZMP
+    inside the support polygon, the joints within their limits, no collision).
+    """
+    terrain = rw.load_terrain("flat:length=1.2,width=0.5")
+    plan = straight_crawl_plan(littledog, terrain, (0.3, 0.0), steps=4, stride=0.07)
+    shifts = {}
+    for stretch_shift in (True, False):
+        config = rw.trajectories.trajectory_config(
+            **EVEN_SWINGS, **{"timing.measured_speed": 0.0, "timing.stretch_shift": stretch_shift}
+        )
+        gen = FootstepTrajectoryGenerator(littledog, terrain, config=config)
+        hurried = _hurried(gen.prepare(plan), 0.4)
+        steps = list(gen.iter_steps(hurried))
+        for traj in steps:
+            r = traj.report
+            assert r.valid and r.velocity_limits_ok, f"step {r.step}: {r.notes}"
+            assert r.swing_s > 1.5 * r.fitted_swing_s
+        shifts[stretch_shift] = np.array([t.report.shift_s for t in steps])
+        if not stretch_shift:
+            fitted = np.array([t.report.fitted_shift_s for t in steps])
+            # At most the shift's floor for its ZMP travel is put back.
+            assert np.all(shifts[False] <= np.maximum(fitted, gen.config.timing.min_shift_s) + 1e-9)
+    assert np.all(shifts[False] <= shifts[True] + 1e-9)
+    assert shifts[False].sum() < shifts[True].sum() - 0.05

@@ -290,6 +290,23 @@ class TimingConfig:
     settle_s:
         After the last step, four feet down while the centre of mass comes to
         rest over the final pose [s].
+    stretch_shift:
+        Whether the re-timing of a swing whose initial trajectory breaks a
+        joint's velocity limit (the generator's ``_retimed``: the step
+        lengthened by the swing leg's peak speed over its limit) lengthens
+        the shift as well (True, default), or only the swing (False). Only
+        the swing leg's airborne speed is measured there, so the shift's
+        share of the stretch is time the limit does not ask for (large
+        rocks seed 0: 0.06 s of its 0.30 s stretch); a longer shift gives
+        the preview controller more time to move the ZMP, though. Off
+        (``bench_littledog.py --expansions 40000 --classes large_rocks``):
+        seed 0 7.15 → 7.30 cm/s, but seed 3 (5.36 cm/s after one reflex)
+        fails (its re-plan after the reflex finds no start certificate);
+        with ``swing.law_trunk`` "moving" as well, large rocks seeds 0–7
+        6/8 at 6.42 cm/s (main 5/8 at 5.30; seed 3 lost, 4 and 6 gained)
+        and the 1 N·s right push (``bench_push_recovery.py --from 1.6 --to
+        3.2 --direction -90``) 6/9 (main 7/9: 2.0 s falls too), left 8/9
+        as main. Hence on.
 
     Session 10: where a run's clock goes, and the shift defaults
     (``min_shift_s`` 0.2 → 0.1, ``first_shift_s`` 0 → 0.2,
@@ -347,6 +364,7 @@ class TimingConfig:
     max_step_s: float = 4.0
     settle_s: float = 0.8
     swing_trunk: str = "moving"
+    stretch_shift: bool = True
 
     def shift_floor(self, travel: float) -> float:
         """Shortest shift phase [s] for a ZMP travel of ``travel`` [m]."""
@@ -578,6 +596,36 @@ class SwingConfig:
         (``bench_push_recovery.py --from 1.6 --to 3.2``) at 0.005: left 8/9,
         right 7/9 (8/9, 8/9 off), hence still off. With the defaults since
         session 15 (the fast options everywhere) it changes nothing.
+    law_trunk:
+        The trunk under which the ``"joint"`` time law paces a step's swing
+        (and picks its path and law by the least time): ``"swing_pose"``
+        (default), the pose held through the swing, where a step down a
+        rock misses its target by 3–6 cm (the trunk reaches it only by
+        lowering into the landing pose) and the law falls back to
+        ``"even"``; ``"moving"``, the initial trajectory's trunk from
+        lift-off to touchdown (:func:`~roughwalk.trajectories.initial_trajectory.moving_trunk_leg`),
+        so the limiting joint runs near its limit along the whole swing
+        rather than at one point of it. Only the initial trajectory's swing
+        changes; the nominal timing still uses the swing pose. Large rocks
+        seeds 0–7 (``bench_littledog.py --expansions 40000 --classes
+        large_rocks``), main 5/8 at 5.30 cm/s → "moving" 7/8 at 6.21 (seed
+        0 7.15 → 7.91 with no reflex either way, seed 1 5.10 → 7.23 with
+        its reflex gone, seed 3 5.36 → 4.81 with two); but the 1 N·s right
+        push (``bench_push_recovery.py --from 1.6 --to 3.2 --direction
+        -90``) survives 6 of 9 against 7 (2.0 s, in LF's swing on level
+        ground, rolls over), hence off; see ``law_trunk_rise``.
+    law_trunk_rise:
+        With ``law_trunk`` "moving", only swings whose target lies at least
+        this far [m] above or below their start are paced under the moving
+        trunk (the steps up and down rocks it is for); the others keep the
+        swing pose. 0: every swing. On level ground nothing changes then.
+        At 0.01 with "moving" (``bench_littledog.py --expansions 40000``):
+        large rocks seeds 0–7 6/8 at 5.93 cm/s (main 5/8 at 5.30; seed 6
+        gained), the other five classes 2/2 each and faster on seeds 0–1
+        (round rocks 7.54 → 8.41, sloped rocks 8.50 → 9.31, gap 7.60 →
+        7.62, barrier 8.52 → 8.64, steps 8.63 → 8.98), but logs seeds 0–5
+        lose seed 1 (main 3.69 cm/s after its reflexes; 6 reflexes, given
+        up) and gain seed 5: 4/6 at 8.08 against 7.71. Hence off.
     """
 
     lift_height: float = 0.03
@@ -590,9 +638,17 @@ class SwingConfig:
     path: str = "joint"
     lift_off_reach: bool = True
     fast_swing_relief: float = 0.0
+    law_trunk: str = "swing_pose"
+    law_trunk_rise: float = 0.0
 
     def __post_init__(self) -> None:
-        _check_nonnegative(self, ("lift_height", "clearance", "fast_swing_relief"), "swing")
+        _check_nonnegative(
+            self, ("lift_height", "clearance", "fast_swing_relief", "law_trunk_rise"), "swing"
+        )
+        if self.law_trunk not in ("swing_pose", "moving"):
+            raise ConfigError(
+                f"swing.law_trunk must be 'swing_pose' or 'moving', got {self.law_trunk!r}"
+            )
         if self.path not in ("cartesian", "joint"):
             raise ConfigError(f"swing.path must be 'cartesian' or 'joint', got {self.path!r}")
         if not (math.isfinite(self.lift_fraction) and 0 <= self.lift_fraction < 0.5):

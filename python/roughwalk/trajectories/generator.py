@@ -583,18 +583,28 @@ class FootstepTrajectoryGenerator:
         """
         cfg = self.config
         nominal = base if base is not None else prepared.timings[k]
-        state = self.initial_state(prepared, k, start, use_shortcut, scale * stretch, nominal)
+        state = self.initial_state(
+            prepared, k, start, use_shortcut, scale, self._stretched(nominal, stretch)
+        )
         for _ in range(RETIME_LIMIT):
             ratio = swing_speed_ratio(state, self.wb, cfg.control_rate_hz)
             if ratio <= 1.0:
                 break
             longer = stretch * ratio * RETIME_MARGIN
-            timing = nominal.scaled(scale * longer)
+            timing = self._stretched(nominal, longer).scaled(scale)
             if timing.shift_s + timing.swing_s > cfg.timing.max_step_s:
                 break
             stretch = longer
-            state = self.initial_state(prepared, k, start, use_shortcut, scale * stretch, nominal)
+            state = self.initial_state(
+                prepared, k, start, use_shortcut, scale, self._stretched(nominal, stretch)
+            )
         return state, stretch
+
+    def _stretched(self, timing: StepTiming, stretch: float) -> StepTiming:
+        """``timing`` made longer by the re-timing factor ``stretch`` (``timing.stretch_shift``)."""
+        if self.config.timing.stretch_shift:
+            return timing.scaled(stretch)
+        return replace(timing, swing_s=timing.swing_s * stretch)
 
     def fitted_timing(
         self, prepared: PreparedPlan, k: int, start: StartState, use_shortcut: bool
@@ -737,7 +747,7 @@ class FootstepTrajectoryGenerator:
         state: FootstepState | None = None
         stretch = 1.0
         for attempt, (use_shortcut, scale) in enumerate(plans, start=1):
-            timing = base.scaled(scale * stretch)
+            timing = self._stretched(base, stretch).scaled(scale)
             if timing.shift_s + timing.swing_s > cfg.timing.max_step_s and attempt > 1:
                 break
             state, stretch = self._retimed(prepared, k, start, use_shortcut, scale, stretch, base)

@@ -25,7 +25,7 @@ from roughwalk.trajectories.config import SwingConfig
 from roughwalk.trajectories.euler import matrix_to_rpy, rpy_to_matrix, skew
 from roughwalk.trajectories.step_sequence import StepSpec
 from roughwalk.trajectories.support_polygon import convex_polygon
-from roughwalk.trajectories.swing_spline import SwingSpline
+from roughwalk.trajectories.swing_spline import LegAngles, LegFeet, SwingSpline
 from roughwalk.trajectories.timing import StepTiming
 from roughwalk.trajectories.whole_body import WholeBody
 from roughwalk.trajectories.zmp_preview import PreviewRun, ZmpPreviewController
@@ -200,6 +200,46 @@ def _unwrap_to(angle: float, reference: float) -> float:
     return reference + math.remainder(angle - reference, 2 * math.pi)
 
 
+def moving_trunk_leg(
+    wb: WholeBody, swing_pose: BodyKeyframe, trunk: NDArray[np.float64], leg: int
+) -> tuple[LegAngles, LegFeet]:
+    """IK and FK of leg ``leg`` under the trunk as it moves through the swing.
+
+    ``trunk`` (m, 6): the trunk's poses (x, y, z [m], roll, pitch, yaw [rad])
+    from lift-off to touchdown. The n points (angles) given to either
+    function are taken in the order the foot passes them, the i-th under
+    the trunk at fraction i / (n − 1) of the swing (linear between
+    samples): for the ``"joint"`` time law's pace, which at the swing pose
+    alone misses a target the trunk only reaches by lowering into the
+    landing pose (``SwingConfig.law_trunk``). The other legs hold their
+    swing-pose feet.
+    """
+    rows = np.asarray(trunk, dtype=float)
+    held = (swing_pose.feet - swing_pose.base_pos) @ swing_pose.rotation
+
+    def poses(n: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        at = np.linspace(0.0, len(rows) - 1.0, n)
+        pose = np.column_stack([np.interp(at, np.arange(len(rows)), rows[:, j]) for j in range(6)])
+        return pose[:, :3], rpy_to_matrix(pose[:, 3:])
+
+    def angles(points: NDArray[np.float64]) -> NDArray[np.float64]:
+        p = np.asarray(points, dtype=float).reshape(-1, 3)
+        base, rot = poses(len(p))
+        feet_b = np.repeat(held[None], len(p), axis=0)
+        feet_b[:, leg] = np.einsum("nji,nj->ni", rot, p - base)
+        return np.asarray(wb.inverse_kinematics(feet_b)[0][:, leg], dtype=float)
+
+    def feet(q_leg: NDArray[np.float64]) -> NDArray[np.float64]:
+        a = np.asarray(q_leg, dtype=float).reshape(-1, 3)
+        base, rot = poses(len(a))
+        q = np.repeat(swing_pose.q[None], len(a), axis=0)
+        q[:, leg] = a
+        local = np.asarray(wb.foot_positions(q), dtype=float)[:, leg]
+        return base + np.einsum("nij,nj->ni", rot, local)
+
+    return angles, feet
+
+
 def build_initial_trajectory(
     wb: WholeBody,
     step: StepSpec,
@@ -311,6 +351,10 @@ def build_initial_trajectory(
     body[:, 2] = pose[:, 0]
     body[:, 3:] = pose[:, 1:4]
 
+    law_legs = None
+    rise = abs(float(step.target[2] - step.start[2]))
+    if swing_config.law_trunk == "moving" and rise >= swing_config.law_trunk_rise:
+        law_legs = moving_trunk_leg(wb, swing_pose, body[lift_off : touchdown + 1], step.leg)
     swing = SwingSpline.plan(
         step.start,
         step.target,
@@ -322,6 +366,7 @@ def build_initial_trajectory(
         velocity_limit=wb.velocity_limit[step.leg],
         leg_feet=swing_pose.leg_feet(wb, step.leg),
         joint_range=(wb.lower[step.leg], wb.upper[step.leg]),
+        law_legs=law_legs,
     )
     feet = np.repeat(step.stance_before[None], n + 1, axis=0)
     feet[lift_off : touchdown + 1, step.leg] = swing.position(

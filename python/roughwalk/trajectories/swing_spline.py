@@ -500,6 +500,7 @@ class SwingSpline:
         velocity_limit: ArrayLike | None = None,
         leg_feet: LegFeet | None = None,
         joint_range: tuple[ArrayLike, ArrayLike] | None = None,
+        law_legs: tuple[LegAngles, LegFeet] | None = None,
     ) -> SwingSpline:
         """The heuristic lift-off and drop-off points, then the spline.
 
@@ -516,6 +517,13 @@ class SwingSpline:
         instead shaped in joint space (:func:`_joint_path_waypoints`;
         ``joint_range``: the leg's (lower, upper) angles [rad]), and kept
         where it allows a shorter swing than the heuristic one.
+
+        ``law_legs``: the leg's IK and FK to time the ``"joint"`` law by
+        (and to compare paths and laws by) instead of ``leg_angles`` and
+        ``leg_feet``, where they differ: with ``SwingConfig.law_trunk``
+        "moving", under the trunk as it moves through the swing; those take
+        points (angles) in the order the foot passes them, from lift-off to
+        touchdown. The path's shape is still made at the fixed pose.
         """
         s = np.asarray(start, dtype=float)
         t = np.asarray(target, dtype=float)
@@ -550,16 +558,20 @@ class SwingSpline:
                 leg_angles,
                 limit,
                 leg_feet=leg_feet,
+                law_legs=law_legs,
             )
             waypoints = _remembered_shape(
                 s, t, config, terrain, foot_radius, leg_angles, leg_feet, limit, limits
             )
             if waypoints is None:
                 return heuristic
-            shaped = cls._timed(waypoints, duration, config, leg_angles, limit, leg_feet)
+            timed_by, timed_feet = law_legs if law_legs is not None else (leg_angles, leg_feet)
+            shaped = cls._timed(waypoints, duration, config, timed_by, limit, timed_feet)
             # The shape's cost stands in for the time law's pace: keep
             # whichever path the joints' peak speeds allow the shorter swing.
-            return min((shaped, heuristic), key=lambda c: c.least_time(leg_angles, limit))
+            return min((shaped, heuristic), key=lambda c: c.least_time(timed_by, limit))
+        if law_legs is not None:
+            leg_angles, leg_feet = law_legs
         top = max(s[2], t[2]) + config.lift_height
         if config.scan_terrain and terrain is not None:
             ground = float(np.max(terrain.height(_path_corridor(s, t, foot_radius))))
