@@ -86,18 +86,22 @@ def test_no_step_where_the_other_three_feet_cannot_hold_the_trunk() -> None:
     assert replant_segments(robot, squeezed, 0, target, 0.25, 0.3, 0.0, 0.015) is None
 
 
+def _flank() -> Terrain:
+    """A ramp rising 50° from x = 0.60 to 0.62, flat beyond: a foot at x ≈ 0.61 stands on it."""
+    x = np.arange(0.0, 0.8, DX)
+    y = np.arange(-0.3, 0.3, DX)
+    xx, _ = np.meshgrid(x, y, indexing="ij")
+    h = np.clip((xx - 0.60) * np.tan(np.radians(50.0)), 0.0, 0.02 * np.tan(np.radians(50.0)))
+    return Terrain(h, x0=0.0, y0=-0.3, dx=DX, dy=DX, name="flank")
+
+
 @pytest.mark.skipif(
     not hasattr(_core, "FootstepPlanner"), reason="the compiled core has no footstep planner"
 )
 def test_a_foot_on_a_flank_is_replanted_on_the_nearest_gentle_foothold() -> None:
     """RF on a 50° ramp with a 40° limit: it moves; the feet on flat ground stay."""
     robot = rw.load_robot("littledog")
-    x = np.arange(0.0, 0.8, DX)
-    y = np.arange(-0.3, 0.3, DX)
-    xx, _ = np.meshgrid(x, y, indexing="ij")
-    # A ramp rising 50° from x = 0.60 to 0.62, flat beyond: RF's foot stands on it.
-    h = np.clip((xx - 0.60) * np.tan(np.radians(50.0)), 0.0, 0.02 * np.tan(np.radians(50.0)))
-    terrain = Terrain(h, x0=0.0, y0=-0.3, dx=DX, dy=DX, name="flank")
+    terrain = _flank()
     source = PlannerSource(robot, terrain, expansions=10, config=planner_config(robot, 0.4, {}))
     r = robot.foot_radius
     steep = steep_footholds(terrain, r, np.radians(40.0))
@@ -247,11 +251,7 @@ def test_a_foot_stays_where_the_stance_it_would_make_has_no_certificate(littledo
 def test_a_foot_on_a_flank_steps_where_the_stance_it_makes_is_certified() -> None:
     """RF on a 50° ramp, the other feet on flat ground: the certified step is queued."""
     robot = rw.load_robot("littledog")
-    x = np.arange(0.0, 0.8, DX)
-    y = np.arange(-0.3, 0.3, DX)
-    xx, _ = np.meshgrid(x, y, indexing="ij")
-    h = np.clip((xx - 0.60) * np.tan(np.radians(50.0)), 0.0, 0.02 * np.tan(np.radians(50.0)))
-    terrain = Terrain(h, x0=0.0, y0=-0.3, dx=DX, dy=DX, name="flank")
+    terrain = _flank()
     st = robot.nominal_stance
     base = np.array([0.5, 0.0, st.base_height])
     feet = st.feet + [0.5, 0.0, 0.0]
