@@ -153,3 +153,28 @@ def test_the_init_bench_measures_the_walk_at_the_clearance_it_is_given() -> None
     assert bench._models(None, bench.walk_space("single_pallet", "0.6")) == []
     with pytest.raises(SystemExit, match="--swing-base-clearance"):
         bench.walk_space("single_pallet", "low")
+
+
+def test_the_tracking_bench_finds_the_single_pallet_s_optimised_duration_model() -> None:
+    # Melon et al.'s Fig. 8 executes plans with optimised phase durations too;
+    # the bench's learned point there needs a model of that NLP (its layout
+    # holds the phase durations), not the fixed-duration walk's.
+    from roughwalk.learning.initializer import model_for_spec
+
+    bench = load_benchmark("bench_tracking")
+    space = task_space("single_pallet")
+    assert bench.learned_model_for("single_pallet", True) == ""
+    model = model_for_spec("learned", bench._spec("single_pallet", True))
+    problem = model.header["problem"]
+    assert problem["optimize_durations"] is True
+    assert (problem["steps"], problem["duration"]) == (space.steps, space.duration)
+    assert problem["swing_base_clearance"] == space.swing_base_clearance == 0.5
+    durations = [size for name, size in model.header["layout"] if name.startswith("durations_")]
+    assert len(durations) == 4 and min(durations) > 0
+    # Trained on the fixed-duration walk's constraint set, so the bench's
+    # heuristic and learned starts solve the same NLP.
+    constraints, _ = bench.learned_problem("single_pallet", True)
+    assert constraints is not None and "unilateral_between_nodes" in constraints
+    # The fixed-duration walk keeps its own model.
+    fixed = model_for_spec("learned", bench._spec("single_pallet", False))
+    assert fixed.header["problem"]["optimize_durations"] is False
