@@ -584,27 +584,33 @@ class FootstepTrajectoryGenerator:
         cfg = self.config
         nominal = base if base is not None else prepared.timings[k]
         state = self.initial_state(
-            prepared, k, start, use_shortcut, scale, self._stretched(nominal, stretch)
+            prepared, k, start, use_shortcut, 1.0, self._stretched(nominal, scale, stretch)
         )
         for _ in range(RETIME_LIMIT):
             ratio = swing_speed_ratio(state, self.wb, cfg.control_rate_hz)
             if ratio <= 1.0:
                 break
             longer = stretch * ratio * RETIME_MARGIN
-            timing = self._stretched(nominal, longer).scaled(scale)
+            timing = self._stretched(nominal, scale, longer)
             if timing.shift_s + timing.swing_s > cfg.timing.max_step_s:
                 break
             stretch = longer
             state = self.initial_state(
-                prepared, k, start, use_shortcut, scale, self._stretched(nominal, stretch)
+                prepared, k, start, use_shortcut, 1.0, self._stretched(nominal, scale, stretch)
             )
         return state, stretch
 
-    def _stretched(self, timing: StepTiming, stretch: float) -> StepTiming:
-        """``timing`` made longer by the re-timing factor ``stretch`` (``timing.stretch_shift``)."""
+    def _stretched(self, timing: StepTiming, scale: float, stretch: float) -> StepTiming:
+        """``timing`` scaled by a restart's ``scale`` and the re-timing's ``stretch``.
+
+        With ``timing.stretch_shift`` (the default) both phases take both
+        factors, multiplied as before the option existed (``scale * stretch``,
+        so that runs repeat bit for bit); without it the shift takes ``scale``
+        alone.
+        """
         if self.config.timing.stretch_shift:
-            return timing.scaled(stretch)
-        return replace(timing, swing_s=timing.swing_s * stretch)
+            return timing.scaled(scale * stretch)
+        return replace(timing, swing_s=timing.swing_s * stretch).scaled(scale)
 
     def fitted_timing(
         self, prepared: PreparedPlan, k: int, start: StartState, use_shortcut: bool
@@ -747,7 +753,7 @@ class FootstepTrajectoryGenerator:
         state: FootstepState | None = None
         stretch = 1.0
         for attempt, (use_shortcut, scale) in enumerate(plans, start=1):
-            timing = self._stretched(base, stretch).scaled(scale)
+            timing = self._stretched(base, scale, stretch)
             if timing.shift_s + timing.swing_s > cfg.timing.max_step_s and attempt > 1:
                 break
             state, stretch = self._retimed(prepared, k, start, use_shortcut, scale, stretch, base)
