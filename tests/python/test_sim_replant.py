@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import dataclasses
+from typing import Any
 
 import numpy as np
 import pytest
@@ -39,20 +40,25 @@ def _standing(robot: rw.Robot, terrain: Terrain) -> tuple[Runner, JointControlle
     return runner, JointController(world), measured
 
 
+def _level_pose(robot: rw.Robot, measured: Any, kind: str) -> Any:
+    """The level trunk over the measured feet, all four down, as one ``kind`` pose sample."""
+    return pose_segment(
+        robot,
+        np.repeat(measured.base_pos[None], 2, axis=0),
+        np.zeros((2, 3)),
+        np.repeat(measured.feet[None], 2, axis=0),
+        np.ones(4, dtype=bool),
+        1e-3,
+        kind,
+        0.0,
+    ).last()
+
+
 def test_a_replanted_foot_steps_to_its_target_while_the_others_stay() -> None:
     robot = rw.load_robot("littledog")
     runner, controller, measured = _standing(robot, rw.load_terrain("flat"))
     for _ in range(100):  # settle 0.2 s on four feet
-        still = pose_segment(
-            robot,
-            np.repeat(measured.base_pos[None], 2, axis=0),
-            np.zeros((2, 3)),
-            np.repeat(measured.feet[None], 2, axis=0),
-            np.ones(4, dtype=bool),
-            1e-3,
-            "hold",
-            0.0,
-        ).last()
+        still = _level_pose(robot, measured, "hold")
         measured = runner.step(controller.command(still.q, still, measured))
     start = measured.feet.copy()
     target = start[1] + [0.02, -0.01, 0.0]  # RF 2.2 cm forward and out
@@ -121,16 +127,7 @@ def test_a_foot_on_a_flank_is_replanted_on_the_nearest_gentle_foothold() -> None
 def test_a_held_foot_sliding_off_its_recovery_foothold_is_caught_while_three_bear() -> None:
     robot = rw.load_robot("littledog")
     _, _, measured = _standing(robot, rw.load_terrain("flat"))
-    held = pose_segment(
-        robot,
-        np.repeat(measured.base_pos[None], 2, axis=0),
-        np.zeros((2, 3)),
-        np.repeat(measured.feet[None], 2, axis=0),
-        np.ones(4, dtype=bool),
-        1e-3,
-        "recovery",
-        0.0,
-    ).last()
+    held = _level_pose(robot, measured, "recovery")
     footholds = measured.feet.copy()
     loads = np.zeros((4, 3))
     loads[:, 2] = 6.0

@@ -617,16 +617,8 @@ class Executor:
         The foothold as ``reflex.replant_max_slope`` finds one (when that is
         on and the source has a planner), else the foot's own position.
         """
-        cfg = self.config.reflex
         foot = np.array(measured.feet[leg], dtype=float)
-        found = self._replant_planner()
-        if found is None:
-            return foot
-        planner, steep = found
-        terrain, r = self.terrain_for_recovery, self.robot.foot_radius
-        for moved, target in replant_targets(
-            planner, terrain, measured.feet, r, cfg.replant_snap_m, steep
-        ):
+        for moved, target in self._replant_targets(measured):
             if moved == leg and self._replant_certified(measured, leg, target):
                 return np.asarray(target, dtype=float)
         return foot
@@ -651,6 +643,22 @@ class Executor:
             trunk=trunk if self.config.reflex.replan_from_trunk else None,
         )
         return bool(certifies(start, self._goal))
+
+    def _replant_targets(
+        self, measured: MeasuredState, min_m: float = 0.0
+    ) -> list[tuple[int, np.ndarray]]:
+        """(leg, foothold) for each foot re-planting would move ``min_m`` [m] or more; [] when off.
+
+        :func:`~roughwalk.sim.foothold_snap.replant_targets` with
+        :meth:`_replant_planner`'s planner and too-steep cells.
+        """
+        found = self._replant_planner()
+        if found is None:
+            return []
+        planner, steep = found
+        terrain, r = self.terrain_for_recovery, self.robot.foot_radius
+        snap = self.config.reflex.replant_snap_m
+        return replant_targets(planner, terrain, measured.feet, r, snap, steep, min_m)
 
     def _replant_planner(self) -> tuple[Any, np.ndarray] | None:
         """The footstep planner re-planting uses and the too-steep cells; None when it is off.
@@ -706,14 +714,7 @@ class Executor:
         the footholds, if the other three can hold the trunk.
         """
         cfg = self.config.reflex
-        found = self._replant_planner()
-        if found is None:
-            return False
-        planner, steep = found
-        terrain, r = self.terrain_for_recovery, self.robot.foot_radius
-        for leg, target in replant_targets(
-            planner, terrain, measured.feet, r, cfg.replant_snap_m, steep, cfg.replant_min_m
-        ):
+        for leg, target in self._replant_targets(measured, cfg.replant_min_m):
             if leg in self._replanted:
                 continue
             self._replanted.add(leg)
