@@ -110,3 +110,19 @@ def test_only_feasible_solves_with_multipliers_join_the_pool() -> None:
     assert not pool.add({**row, "lam_g": np.full(2, np.nan)})
     assert len(pool) == 1
     np.testing.assert_allclose(pool.scale, [0.2, 0.2, 0.4, 1.0, 1.0, 1.0])
+
+
+def test_a_time_limit_reaches_the_solves_started_from_neighbours(
+    seed_run: Path, tmp_path: Path
+) -> None:
+    data = generate(
+        SPEC,
+        SPACE,
+        3,
+        tmp_path / "grown",
+        progress=None,
+        max_iter=LIMIT,
+        seeds=[seed_run],
+        time_limit_s=1e-6,
+    )
+    assert [str(s) for s in data["status"]] == ["timeout"] * 3

@@ -83,6 +83,13 @@ def register(sub: Any) -> None:
     g.add_argument("--seed", type=int, default=0, help="task sampling seed")
     g.add_argument("--max-iter", type=int, help="IPOPT iterations (default 100, N_h)")
     g.add_argument(
+        "--time-limit",
+        type=float,
+        metavar="SECONDS",
+        help="IPOPT's wall-time limit per solve (default: the solver's, 40 s); raise it on a "
+        "busy machine, where a solve can stop on time before its iteration limit",
+    )
+    g.add_argument(
         "--init",
         default="heuristic",
         help="heuristic (default), learned:MODEL, or nearest:RUN[,RUN...]: each task from the "
@@ -234,6 +241,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         jitter_seed=args.jitter_seed,
         seeds=seeds,
         batch=args.workers,
+        time_limit_s=args.time_limit,
     )
     solved = int(sum(s in ("exact", "approximate") for s in data["status"]))
     print(f"{len(data)} tasks in {out / 'dataset.npz'}: {solved} converged")

@@ -87,6 +87,8 @@ class SolveJob:
     """Further starts for a converged solve dearer than ``cost_limit`` (library candidates)."""
     restart_scale: NDArray[np.float64] | None = None
     """The distance scale :func:`~roughwalk.learning.solution_library.farthest` chooses them in."""
+    time_limit_s: float | None = None
+    """IPOPT's wall-time limit [s]; None: the problem's ``solver.time_limit_s``."""
 
 
 class FixedGuess:
@@ -224,7 +226,7 @@ def solve_job(job: SolveJob) -> dict[str, Any]:
     guess = FixedGuess(
         x0, job.lam_x0, job.lam_g0, job.fallback, job.cost_limit, job.restarts, job.restart_scale
     )
-    result = problem.solve(job.task, guess, max_iter=job.max_iter)
+    result = problem.solve(job.task, guess, max_iter=job.max_iter, time_limit_s=job.time_limit_s)
     return result_row(job.index, result, x0)
 
 
@@ -379,6 +381,7 @@ def generate(
     jitter_seed: int = 0,
     seeds: Sequence[str | Path] | None = None,
     batch: int = 1,
+    time_limit_s: float | None = None,
 ) -> Dataset:
     """Solve tasks 0..n_tasks−1 of ``space``'s ``split`` into ``folder``; resume what is there.
 
@@ -417,6 +420,12 @@ def generate(
         of this run, nearest tasks first, ``batch`` (the executor's workers)
         at a time (:mod:`~roughwalk.learning.neighbour_starts`); ``init``
         names them (``nearest:RUN,...``).
+    time_limit_s:
+        IPOPT's wall-time limit of each solve [s]; None: the problem's
+        ``solver.time_limit_s``. It changes no iterate, only where a slow
+        solve stops (its row's status is then "timeout"), so it is not part
+        of what a resumed folder must match; the run records the last one
+        used as "time_limit_s".
 
     Returns
     -------
@@ -429,6 +438,8 @@ def generate(
             f"the problem is on terrain '{spec.terrain}' but the task space "
             f"'{space.name}' is on '{space.terrain}'"
         )
+    if time_limit_s is not None and not time_limit_s > 0:
+        raise ConfigError(f"time_limit_s must be > 0 seconds, got {time_limit_s}")
     if seeds is not None and model is not None:
         raise ConfigError("a run starts from a model's guesses or from seed runs' solves, not both")
     if seeds is not None:
@@ -456,6 +467,10 @@ def generate(
         },
         unrecorded={"solver": UNRECORDED_SOLVE_SETTINGS},
     )
+    if time_limit_s is not None:
+        # What the solves stop at on this machine, not what the folder solves.
+        run.meta["time_limit_s"] = float(time_limit_s)
+        run._write_meta()
     wanted = list(range(n_tasks)) if indices is None else sorted(set(indices))
     # Tasks the problem refuses (a start no solve can leave) are not solved:
     # the run records why, and the dataset leaves them out.
@@ -477,7 +492,10 @@ def generate(
     done = run.done()
     todo = [i for i in wanted if i not in done]
     tasks = [space.task(i, seed=seed, split=split) for i in todo]
-    jobs = [SolveJob(spec, i, t, max_iter) for i, t in zip(todo, tasks, strict=True)]
+    jobs = [
+        SolveJob(spec, i, t, max_iter, time_limit_s=time_limit_s)
+        for i, t in zip(todo, tasks, strict=True)
+    ]
     if model is not None and tasks:
         asked = tasks if jitter is None else jittered(tasks, todo, jitter, jitter_seed)
         x0s = model.predict_tasks(asked)
@@ -499,6 +517,7 @@ def generate(
                 None if limits is None else float(limits[k]),
                 tuple(model.other_starts(asked[k])) if limits is not None else (),
                 model.mlp.out_scale,
+                time_limit_s,
             )
             for k, job in enumerate(jobs)
         ]
@@ -514,7 +533,7 @@ def generate(
         pool = seed_pool(spec, space, [Path(f) for f in seeds])
         for row in run.rows():
             pool.add(row)
-        results = neighbour_solves(spec, todo, tasks, pool, max_iter, executor, batch)
+        results = neighbour_solves(spec, todo, tasks, pool, max_iter, executor, batch, time_limit_s)
     for row in results:
         run.record(row)
         finished += 1

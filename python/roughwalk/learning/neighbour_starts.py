@@ -146,12 +146,14 @@ def neighbour_solves(
     max_iter: int,
     executor: Executor,
     batch: int = 1,
+    time_limit_s: float | None = None,
 ) -> Iterator[dict[str, Any]]:
     """Solve ``tasks`` nearest-to-the-pool first, each from its nearest solve; yield the rows.
 
     ``batch`` tasks are handed to ``executor`` at a time (its worker
     count); each yielded feasible row joins ``pool`` before the next batch
-    is chosen.
+    is chosen. ``time_limit_s`` is each solve's wall-time limit (None: the
+    problem's).
     """
     from roughwalk.learning.experience import SolveJob, solve_job
 
@@ -167,7 +169,18 @@ def neighbour_solves(
         for j in order:
             k = left[int(j)]
             x0, lam_x0, lam_g0 = pool.starts[int(nearest[j])]
-            jobs.append(SolveJob(spec, indices[k], tasks[k], max_iter, x0, lam_x0, lam_g0))
+            jobs.append(
+                SolveJob(
+                    spec,
+                    indices[k],
+                    tasks[k],
+                    max_iter,
+                    x0,
+                    lam_x0,
+                    lam_g0,
+                    time_limit_s=time_limit_s,
+                )
+            )
         chosen = {left[int(j)] for j in order}
         left = [k for k in left if k not in chosen]
         for row in executor.run(solve_job, jobs):
