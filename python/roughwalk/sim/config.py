@@ -467,10 +467,18 @@ class ReflexConfig:
         foot-force check, whose later capture step of the swinging RH goes
         4 cm further out: 6/9 right) and rescues the 1.6 s left one (9/9 left).
         Sides only: the 1 N·s sweeps (``--from 1.6 --to 3.2``) survive
-        the same push times as without, 7/9 right and 8/9 left; on large
-        rocks (``bench_littledog.py --expansions 40000``) it never fires
-        in seeds 0–11: their falls start inside recoveries, where no
-        reflex watches, or on a diagonal. Off: no run gained.
+        the same push times as without, 7/9 right and 8/9 left; large
+        rocks seeds 0–11 (``bench_littledog.py --expansions 40000``) 7/12
+        at 5.50 cm/s as without, the seven won runs the same to the
+        millisecond. It fires in seeds 6 and 11 only, sooner than the
+        reflex that ended main's run (seed 11: 2.56 s, RF unloaded, where
+        main's foot-force reflex at 2.75 s led to a roll at 3.24 s; seed
+        6: 3.30 s, before a foot-position reflex whose re-plan had no
+        plan): both robots survive that recovery and walk on, then meet
+        the state again and again (4 and 2 more one-sided reflexes) and
+        roll over at 5.96 and 5.32 s. Seeds 4 and 10 fall in recoveries,
+        where no reflex watches (on a diagonal, RF sliding 5 cm down its
+        flank). Off: no run gained.
     one_sided_rate_rad_s, one_sided_persist_s, one_sided_loaded_n:
         See ``one_sided``; a foot bearing more than ``one_sided_loaded_n``
         [N] counts as loaded.
