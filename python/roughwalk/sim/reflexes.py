@@ -5,6 +5,9 @@ which attempts to restore the robot's balance and place all four feet
 firmly on the ground. The reflex module can be triggered by body position
 or orientation errors, foot position errors, or foot force errors."
 
+Opt-in, a fifth trigger: the one-sided state (:func:`tipping_off`), every
+loaded foot on one side while the trunk rolls over them.
+
 Each error must persist for :attr:`ReflexConfig.persist_s` so that the
 transients of a touchdown do not fire it. The recovery motion itself is
 :func:`roughwalk.sim.recovery.recovery_segment`; the executor then re-plans.
@@ -25,9 +28,19 @@ if TYPE_CHECKING:
     from roughwalk.sim.measured_state import MeasuredState
     from roughwalk.sim.trajectory_buffer import DesiredState
 
-__all__ = ["ReflexMonitor", "ReflexTrigger", "lean_toward", "orientation_error"]
+__all__ = [
+    "ReflexMonitor",
+    "ReflexTrigger",
+    "lean_toward",
+    "orientation_error",
+    "tipping_off",
+    "SIDES",
+]
 
-_KINDS = ("body_position", "body_orientation", "foot_position", "foot_force")
+_KINDS = ("body_position", "body_orientation", "foot_position", "foot_force", "one_sided")
+
+SIDES = ((0, 2), (1, 3))
+"""The canonical legs of the left side (LF, LH) and of the right side (RF, RH)."""
 
 
 @dataclass(frozen=True)
@@ -35,8 +48,9 @@ class ReflexTrigger:
     """Why a reflex fired.
 
     ``kind`` is one of body_position, body_orientation, foot_position,
-    foot_force; ``value`` and ``threshold`` are in SI units; ``leg`` is the
-    leg concerned (or None); ``time`` the simulated time [s].
+    foot_force, one_sided (``ReflexConfig.one_sided``); ``value`` and
+    ``threshold`` are in SI units; ``leg`` is the leg concerned (or None);
+    ``time`` the simulated time [s].
     """
 
     kind: str
@@ -83,6 +97,50 @@ def lean_toward(com: np.ndarray, feet: np.ndarray, support: np.ndarray) -> np.nd
             normal = -normal
         out[leg] = float(np.dot(p - a, normal))
     return out
+
+
+def tipping_off(
+    support: np.ndarray,
+    loaded: np.ndarray,
+    feet: np.ndarray,
+    angvel: np.ndarray,
+) -> tuple[float, int | None]:
+    """How fast [rad/s] the trunk rolls over its loaded side, lifting the other side's feet.
+
+    ``support`` (4,) the feet planned down, ``loaded`` (4,) those bearing
+    load, ``feet`` (4, 3) [m] where they are, ``angvel`` (3,) [rad/s] the
+    trunk's angular velocity (world axes). When every loaded foot is on
+    one side (:data:`SIDES`) and a foot of the other side is planned down
+    (bearing nothing), the rate is the trunk's rotation about the line of
+    the loaded side's feet in the sense that lifts the other side
+    (negative: it comes down), with the leg of a planned-down foot there.
+    (0, None) in any other state.
+
+    Diagonals are not watched: a crawl stands on one while a foot swings,
+    and the three-foot foot-force check judges that (on the 1 N·s right
+    push at 2.0 s, a diagonal version fired 0.07 s before that check and
+    the robot fell: the swinging RH, stepped out by the capture offset of
+    that instant, went down 4 cm less far out).
+    """
+    if not np.any(loaded):
+        return 0.0, None
+    for side, other in (SIDES, SIDES[::-1]):
+        if any(loaded[k] for k in other):
+            continue
+        lifted = [k for k in other if support[k]]
+        if not lifted:
+            continue
+        a, b = side
+        along = np.array([*(feet[b, :2] - feet[a, :2]), 0.0])
+        length = float(np.linalg.norm(along))
+        if length < 1e-9:
+            continue
+        along /= length
+        # A rotation ω·along lifts a point on the side where (along × offset)·z > 0.
+        offset = np.array([*(feet[lifted[0], :2] - feet[a, :2]), 0.0])
+        lifts = 1.0 if float(np.cross(along, offset)[2]) > 0 else -1.0
+        return float(np.dot(angvel, along)) * lifts, lifted[0]
+    return 0.0, None
 
 
 class ReflexMonitor:
@@ -159,6 +217,14 @@ class ReflexMonitor:
             float(limit[worst]) if np.isfinite(limit[worst]) else float("inf"),
             LEG_NAMES[worst],
         )
+        if cfg.one_sided:
+            loaded_feet = measured.foot_forces[:, 2] > cfg.one_sided_loaded_n
+            rate, leg = tipping_off(down, loaded_feet, measured.feet, measured.base_angvel)
+            out["one_sided"] = (
+                rate,
+                cfg.one_sided_rate_rad_s,
+                LEG_NAMES[leg] if leg is not None else None,
+            )
         return out
 
     def check(self, desired: DesiredState, measured: MeasuredState) -> ReflexTrigger | None:
@@ -177,7 +243,12 @@ class ReflexMonitor:
                     self._short_leg = leg
                 if since is None:
                     self._since[kind] = since = now
-                if fired is None and now - since >= self.config.persist_s - 1e-12:
+                persist = (
+                    self.config.one_sided_persist_s
+                    if kind == "one_sided"
+                    else self.config.persist_s
+                )
+                if fired is None and now - since >= persist - 1e-12:
                     fired = ReflexTrigger(kind, value, threshold, leg, now)
             else:
                 self._since[kind] = None
