@@ -147,6 +147,7 @@ def test_the_guess_through_optimize_motion_is_the_model_s_in_the_optimised_layou
     init = f"{NAME}:{tmp_path / 'tiny.npz'}"
     result = optimize_motion("anymal_c", "flat", TASK, config=config, init=init, max_iter=0)
     assert result.x is not None
+    assert "guess from fixed-duration learned model 'tiny'" in result.message
     parts = _problem(flat, True, WIDE).formulation.split(result.x)
     kept = np.concatenate([v for n, v in parts.items() if not n.startswith("durations")])
     np.testing.assert_allclose(kept, model.predict(TASK), atol=1e-9)

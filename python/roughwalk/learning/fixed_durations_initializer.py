@@ -195,6 +195,12 @@ class FixedDurationsInitializer(LearnedInitializer):
             self.model = fixed_durations_model(self.argument, signature)
         return self.model
 
+    def source(self) -> str | None:
+        """The fixed-duration model the guess comes from, for the result's message."""
+        if self.model is None:
+            return None
+        return f"fixed-duration learned model '{self.model.name}', phase durations at the gait's"
+
     def constraints(
         self, requested: tuple[str, ...], signature: dict[str, object]
     ) -> tuple[str, ...]:

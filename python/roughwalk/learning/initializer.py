@@ -146,6 +146,10 @@ class LearnedInitializer:
         """The task as given."""
         return task
 
+    def source(self) -> str | None:
+        """The model the guess comes from (None before one is chosen), for the result's message."""
+        return None if self.model is None else f"learned model '{self.model.name}'"
+
     def constraints(
         self, requested: tuple[str, ...], signature: dict[str, object]
     ) -> tuple[str, ...]:
