@@ -233,7 +233,8 @@ class FixedDurationsInitializer(LearnedInitializer):
         rows = to_optimised_rows(nlp, lam_g[0])
         if rows is None:
             return None, None
-        # The durations' bound multipliers: 0 (the gait's durations are interior).
+        # The durations' bound multipliers: 0 (inactive at the gait's durations; a
+        # clamped phase sits on its bound, but the fixed NLP had no multiplier for it).
         bounds = to_optimised_variables(nlp, lam_x[0])
         at = 0
         for v in nlp.variable_sets:
@@ -248,7 +249,12 @@ class FixedDurationsInitializer(LearnedInitializer):
         return super().has_fallback(nlp)
 
     def cost_limit(self, nlp: Formulation, task: ResolvedTask) -> float | None:
-        """The fixed-duration model's per-task g_max (optimised durations can only lower it)."""
+        """The fixed-duration model's per-task g_max.
+
+        Freeing the durations can only lower the optimum (the gait's durations,
+        a clamped phase aside, are a point of the optimised NLP), so a solve
+        that ends above it is still a poor minimum.
+        """
         self._model(problem_signature(nlp))
         return super().cost_limit(nlp, task)
 
