@@ -22,6 +22,14 @@ problem, ``towr_config``), both executed; pictures of each go beside the JSON.
 The ``learned`` initialiser comes from ``roughwalk.learning`` when it is
 installed; otherwise the benchmark says so and runs the heuristic only.
 
+``learned_fixed_durations`` (``--init``) solves the optimised-duration NLP
+from the environment's fixed-duration model's guess, its phase durations at
+the gait's (``roughwalk.learning.fixed_durations_initializer``); the notes
+and each run's ``model`` name the model a learned start used. Every
+initialiser of a run solves the NLP of the ``learned`` model that fits the
+problem, or with optimised durations and no such model, of the
+fixed-duration one.
+
 ``--models DIR`` runs ``learned`` with the model file in DIR that fits each
 problem instead of the shipped one (a candidate before it is shipped).
 
@@ -48,6 +56,8 @@ ENVIRONMENTS = ("double_pallet", "single_pallet", "flat")
 # The pallet tasks of the paper walk 16 steps in 5.5 s; an environment's task
 # space may choose another walk (``walk``), and its learned model shares it.
 GAIT, STEPS, DURATION = "walk", 16, 5.5
+LEARNED = ("learned", "learned_fixed_durations")
+"""The learned initialisers: a model of the problem, and a fixed-duration model's guess."""
 
 
 @dataclass(frozen=True)
@@ -180,26 +190,31 @@ def learned_init(
     optimize_durations: bool,
     models: Path | None,
     trajopt: tuple[tuple[str, str], ...] = (),
+    name: str = "learned",
 ) -> str:
-    """The learned initialiser for this problem: the shipped model, or the one in ``models``.
+    """The learned initialiser ``name`` for this problem: the shipped model, or one in ``models``.
 
     ``models`` is a folder of model files (``--models``); the first whose
-    header fits the problem is used as ``learned:FILE``, so that a candidate
+    header fits the problem (for ``learned_fixed_durations``, the problem
+    with fixed durations) is used as ``NAME:FILE``, so that a candidate
     model is benchmarked before it replaces the shipped one. A folder with
-    no fitting model gives "learned:" + the folder, which
+    no fitting model gives "NAME:" + the folder, which
     :func:`learned_model_for` then reports as unusable.
     """
     if models is None:
-        return "learned"
+        return name
     try:
+        from roughwalk.learning.fixed_durations_initializer import fixed_signature
         from roughwalk.learning.model_file import LearnedModel
     except ImportError:
-        return "learned"
+        return name
     signature = _spec(env, optimize_durations, trajopt).to_dict()
+    if name != "learned":
+        signature = fixed_signature(signature)
     for path in sorted(models.glob("*.npz")):
         if not LearnedModel.load(path).mismatches(signature):
-            return f"learned:{path}"
-    return f"learned:{models}"
+            return f"{name}:{path}"
+    return f"{name}:{models}"
 
 
 def learned_model_for(
@@ -218,6 +233,38 @@ def learned_model_for(
     return ""
 
 
+def learned_model_name(
+    env: str,
+    optimize_durations: bool,
+    init: str,
+    trajopt: tuple[tuple[str, str], ...] = (),
+) -> str | None:
+    """The name of the model ``init`` uses for the problem of ``env`` (None: not learned)."""
+    if init.partition(":")[0] not in LEARNED:
+        return None
+    from roughwalk.learning.initializer import model_for_spec
+
+    return model_for_spec(init, _spec(env, optimize_durations, trajopt)).name
+
+
+def shared_problem(
+    env: str,
+    optimize_durations: bool,
+    models: Path | None,
+    trajopt: tuple[tuple[str, str], ...] = (),
+) -> tuple[tuple[str, ...] | None, tuple[tuple[str, float], ...] | None]:
+    """The constraint set and cost weights every initialiser of ``env`` solves with.
+
+    The ``learned`` model's (:func:`learned_problem`); with optimised
+    durations and no such model (the double pallet), the fixed-duration
+    model's, which ``learned_fixed_durations`` solves with.
+    """
+    learned = learned_init(env, optimize_durations, models, trajopt)
+    if optimize_durations and learned_model_for(env, optimize_durations, learned, trajopt):
+        learned = learned_init(env, optimize_durations, models, trajopt, LEARNED[1])
+    return learned_problem(env, optimize_durations, learned, trajopt)
+
+
 def learned_problem(
     env: str,
     optimize_durations: bool,
@@ -231,7 +278,7 @@ def learned_problem(
     ``unilateral_between_nodes``; a model trained with
     ``costs.force_between_nodes_penalty=10`` weighs that term), so that the
     initialisers compare on one problem. ``init`` is "learned" (the shipped
-    model) or "learned:FILE".
+    model), "learned:FILE" or "learned_fixed_durations[:FILE]".
     """
     try:
         from roughwalk.learning.model_constraints import spec_for_learned
@@ -305,7 +352,7 @@ def run_job(job: Job) -> dict[str, Any]:
     from roughwalk.tracking import track
     from roughwalk.trajopt import Task, optimize_motion
 
-    if job.init.partition(":")[0] == "learned":
+    if job.init.partition(":")[0] in LEARNED:
         import roughwalk.learning  # noqa: F401
     robot = load_robot("anymal_c")
     terrain = load_terrain(job.terrain)
@@ -317,6 +364,7 @@ def run_job(job: Job) -> dict[str, Any]:
         "optimize_durations": job.optimize_durations,
         "index": job.index,
         "start": list(job.start),
+        "model": learned_model_name(job.env, job.optimize_durations, job.init, job.trajopt),
     }
     started, started_cpu = time.perf_counter(), time.process_time()
     try:
@@ -620,12 +668,12 @@ def main() -> None:
     notes += [f"NLP settings: {dict(trajopt)}"] if trajopt else []
     added = tuple(v for v in args.add_constraints.split(",") if v)
     notes += [f"constraints added: {added}"] if added else []
-    if "learned" in inits:
+    if any(i in LEARNED for i in inits):
         why = learned_available()
         if why:
             notes.append(f"learned initialiser unavailable ({why}); heuristic only")
             print(notes[-1])
-            inits = [i for i in inits if i != "learned"]
+            inits = [i for i in inits if i not in LEARNED]
     durations = [d == "optimised" for d in args.durations.split(",") if d]
     jobs = []
     for env in [e for e in args.env.split(",") if e]:
@@ -635,14 +683,19 @@ def main() -> None:
             print(notes[-1])
         for name in inits:
             for opt in durations:
-                learned = learned_init(env, opt, args.models, trajopt)
-                constraints, costs = learned_problem(env, opt, learned, trajopt)
-                init = learned if name == "learned" else name
-                why = learned_model_for(env, opt, init, trajopt) if name == "learned" else ""
+                constraints, costs = shared_problem(env, opt, args.models, trajopt)
+                learned = name in LEARNED
+                init = learned_init(env, opt, args.models, trajopt, name) if learned else name
+                why = learned_model_for(env, opt, init, trajopt) if learned else ""
                 if why:
-                    notes.append(f"{env}: learned initialiser skipped ({why})")
+                    notes.append(f"{env}: {name} initialiser skipped ({why})")
                     print(notes[-1])
                     continue
+                if learned:
+                    model = learned_model_name(env, opt, init, trajopt)
+                    kind = "optimised" if opt else "fixed"
+                    notes.append(f"{env}, {kind} durations: {init} uses model {model}")
+                    print(notes[-1])
                 for it in iters:
                     for i, t in enumerate(tasks):
                         jobs.append(

@@ -34,6 +34,7 @@ def test_optimize_with_a_learned_model_solves_the_nlp_it_was_trained_on(tmp_path
         "anymal_c", "flat", task, init=f"learned:{trained}", **problem
     )
     assert tuple(result.config["constraints"]) == WITH_FORCES
+    assert "guess from learned model 'with_forces'" in result.message  # which model
     default = roughwalk.optimize_motion(
         "anymal_c", "flat", task, init=f"learned:{plain}", **problem
     )

@@ -101,11 +101,22 @@ def _clearance(value: object) -> str:
 
 
 def model_for_spec(init: str, spec: ProblemSpec) -> LearnedModel:
-    """The model named by ``init`` ("learned" or "learned:MODEL"), checked against ``spec``."""
+    """The model ``init`` uses for ``spec``'s problem, checked against it.
+
+    ``init`` is "learned", "learned:MODEL" or the fixed-duration model's
+    ``learned_fixed_durations[:MODEL]`` (:mod:`.fixed_durations_initializer`).
+    """
     name, _, argument = init.partition(":")
-    if name != "learned":
-        raise ConfigError(f"expected 'learned' or 'learned:MODEL', got {init!r}")
     signature = {k: v for k, v in spec.to_dict().items()}
+    if name == "learned_fixed_durations":
+        from roughwalk.learning.fixed_durations_initializer import fixed_durations_model
+
+        return fixed_durations_model(argument or None, signature)
+    if name != "learned":
+        raise ConfigError(
+            f"expected 'learned', 'learned:MODEL' or 'learned_fixed_durations[:MODEL]', "
+            f"got {init!r}"
+        )
     model = _pick(signature) if not argument else load_model(argument)
     model.check_signature(signature)
     return model
@@ -134,6 +145,10 @@ class LearnedInitializer:
     def adjust_task(self, task: ResolvedTask) -> ResolvedTask:
         """The task as given."""
         return task
+
+    def source(self) -> str | None:
+        """The model the guess comes from (None before one is chosen), for the result's message."""
+        return None if self.model is None else f"learned model '{self.model.name}'"
 
     def constraints(
         self, requested: tuple[str, ...], signature: dict[str, object]

@@ -47,7 +47,8 @@ def constraints_for_model(model: LearnedModel, requested: tuple[str, ...]) -> tu
 def spec_for_learned(spec: ProblemSpec, init: str = "learned") -> ProblemSpec:
     """``spec`` with the constraint set and cost weights of ``init``'s model that fits it.
 
-    ``init`` is "learned" (the shipped model) or "learned:FILE". A spec that
+    ``init`` is "learned" (the shipped model), "learned:FILE" or
+    "learned_fixed_durations[:FILE]". A spec that
     names its set keeps it, and the weights it names (see
     :mod:`.model_costs`); one without a fitting model is returned unchanged
     (the heuristic then solves the default NLP).

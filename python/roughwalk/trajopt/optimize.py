@@ -232,6 +232,10 @@ class TrajoptProblem:
             predicted,
         )
         notes = []
+        # A guess that names where it came from (a learned model) says so in the message.
+        source = getattr(initializer, "source", None)
+        if predicted and callable(source) and source():
+            notes.append(f"guess from {source()}")
         visited = [x0, outcome.x]  # the starts and solutions so far, for further starts
         if falls_back and _restartable(outcome.status):
             guessed = time.perf_counter()

@@ -11,7 +11,9 @@ start (guess and multipliers) for a solve from its guess that has not
 converged after ``solver.guess_fallback_after`` iterations; one with
 ``cost_limit(nlp, task)`` and ``other_start(nlp, task, visited)`` offers
 further starts for a solve that converged above that cost (a poor local
-minimum), up to ``solver.dear_guess_restarts`` of them. Other
+minimum), up to ``solver.dear_guess_restarts`` of them. One with
+``source()`` names where its guess came from (a learned model), and the
+result's message says so. Other
 wings add theirs with :func:`register_initializer`; the learning wing
 registers ``learned`` (Melon 2020, §IV) when it is imported, since this wing
 may not import the wings above it.
