@@ -60,6 +60,17 @@ LEARNED = ("learned", "learned_fixed_durations")
 """The learned initialisers: a model of the problem, and a fixed-duration model's guess."""
 
 
+def not_run(init: str, optimize_durations: bool) -> str:
+    """Why ``init`` is left out with these phase durations ("" when it runs).
+
+    With fixed durations ``learned_fixed_durations`` maps nothing: its guess
+    is the ``learned`` fixed-duration model's, run once under that name.
+    """
+    if init.partition(":")[0] == LEARNED[1] and not optimize_durations:
+        return f"{init} with fixed durations is learned's guess; run once, as learned"
+    return ""
+
+
 @dataclass(frozen=True)
 class Job:
     """One solve-and-execute."""
@@ -616,7 +627,11 @@ def main() -> None:
         "--iters", default=",".join(map(str, ITERATIONS)), help="IPOPT iteration limits"
     )
     parser.add_argument("--env", default=",".join(ENVIRONMENTS), help="environments")
-    parser.add_argument("--init", default="heuristic,learned", help="initialisers")
+    parser.add_argument(
+        "--init",
+        default="heuristic,learned,learned_fixed_durations",
+        help="initialisers (learned_fixed_durations runs with optimised durations only)",
+    )
     parser.add_argument(
         "--durations", default="fixed,optimised", help="phase durations: fixed, optimised"
     )
@@ -683,6 +698,10 @@ def main() -> None:
             print(notes[-1])
         for name in inits:
             for opt in durations:
+                if why := not_run(name, opt):
+                    notes.append(f"{env}: {why}")
+                    print(notes[-1])
+                    continue
                 constraints, costs = shared_problem(env, opt, args.models, trajopt)
                 learned = name in LEARNED
                 init = learned_init(env, opt, args.models, trajopt, name) if learned else name

@@ -10,7 +10,12 @@ from _benchmarks import load_benchmark
 from _learned_models import SPEC, heuristic_guess_model
 
 from roughwalk.errors import ConfigError
-from roughwalk.learning import FixedDurationsInitializer, ProblemSpec, build_problem
+from roughwalk.learning import (
+    FixedDurationsInitializer,
+    LearnedInitializer,
+    ProblemSpec,
+    build_problem,
+)
 from roughwalk.learning.fixed_durations_initializer import (
     DURATION_ROWS,
     NAME,
@@ -225,3 +230,21 @@ def test_the_tracking_bench_runs_it_and_names_its_model() -> None:
     constraints, _ = bench.shared_problem("double_pallet", True, None)
     assert constraints is not None and "unilateral_between_nodes" in constraints
     assert "total_duration" in constraints
+
+
+def test_with_fixed_durations_its_guess_is_learned_s_so_the_bench_runs_it_once(
+    tmp_path: Path,
+) -> None:
+    model = heuristic_guess_model()
+    model.save(tmp_path / "tiny.npz")
+    fixed = build_problem(SPEC)  # the tiny model's own (fixed-duration) problem
+    resolved = resolve(TASK, fixed.body, fixed.terrain)
+    ours = FixedDurationsInitializer(str(tmp_path / "tiny.npz"))
+    theirs = LearnedInitializer(str(tmp_path / "tiny.npz"))
+    nlp = fixed.formulation
+    np.testing.assert_array_equal(ours.guess(nlp, resolved), theirs.guess(nlp, resolved))
+    bench = load_benchmark("bench_tracking")
+    assert bench.not_run(NAME, False) != ""
+    assert bench.not_run(f"{NAME}:{tmp_path / 'tiny.npz'}", False) != ""
+    assert bench.not_run(NAME, True) == ""
+    assert bench.not_run("learned", False) == bench.not_run("heuristic", False) == ""
