@@ -248,3 +248,15 @@ def test_with_fixed_durations_its_guess_is_learned_s_so_the_bench_runs_it_once(
     assert bench.not_run(f"{NAME}:{tmp_path / 'tiny.npz'}", False) != ""
     assert bench.not_run(NAME, True) == ""
     assert bench.not_run("learned", False) == bench.not_run("heuristic", False) == ""
+
+
+def test_learned_without_an_optimised_duration_model_points_to_this_initialiser() -> None:
+    bench = load_benchmark("bench_tracking")
+    why = bench.learned_model_for("double_pallet", True, "learned")
+    assert "no shipped learned model fits" in why
+    assert "learned_fixed_durations" in why
+    # With fixed durations a missing model is not pointed there (it would not help).
+    low = (("swing_base_clearance", "0.4"),)
+    assert "learned_fixed_durations" not in bench.learned_model_for(
+        "single_pallet", False, "learned", low
+    )

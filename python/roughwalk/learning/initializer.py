@@ -92,6 +92,11 @@ def _pick(signature: dict[str, object]) -> LearnedModel:
         f"{signature.get('steps')} steps, {signature.get('duration')} s"
         f"{_clearance(signature.get('swing_base_clearance'))}; shipped: "
         f"{have or 'none'}; train one with `roughwalk init` and use learned:MODEL"
+        + (
+            ", or start from a fixed-duration model's guess with learned_fixed_durations"
+            if signature.get("optimize_durations")
+            else ""
+        )
     )
 
 
