@@ -375,10 +375,11 @@ def run_job(job: Job) -> dict[str, Any]:
         "optimize_durations": job.optimize_durations,
         "index": job.index,
         "start": list(job.start),
-        "model": learned_model_name(job.env, job.optimize_durations, job.init, job.trajopt),
+        "model": None,
     }
     started, started_cpu = time.perf_counter(), time.process_time()
     try:
+        row["model"] = learned_model_name(job.env, job.optimize_durations, job.init, job.trajopt)
         result = optimize_motion(
             robot,
             terrain,
@@ -683,12 +684,12 @@ def main() -> None:
     notes += [f"NLP settings: {dict(trajopt)}"] if trajopt else []
     added = tuple(v for v in args.add_constraints.split(",") if v)
     notes += [f"constraints added: {added}"] if added else []
-    if any(i in LEARNED for i in inits):
+    if any(i.partition(":")[0] in LEARNED for i in inits):
         why = learned_available()
         if why:
             notes.append(f"learned initialiser unavailable ({why}); heuristic only")
             print(notes[-1])
-            inits = [i for i in inits if i not in LEARNED]
+            inits = [i for i in inits if i.partition(":")[0] not in LEARNED]
     durations = [d == "optimised" for d in args.durations.split(",") if d]
     jobs = []
     for env in [e for e in args.env.split(",") if e]:
@@ -703,8 +704,12 @@ def main() -> None:
                     print(notes[-1])
                     continue
                 constraints, costs = shared_problem(env, opt, args.models, trajopt)
-                learned = name in LEARNED
-                init = learned_init(env, opt, args.models, trajopt, name) if learned else name
+                base, _, argument = name.partition(":")
+                learned = base in LEARNED
+                # A named model file is used as given; otherwise --models or the shipped one.
+                init = name
+                if learned and not argument:
+                    init = learned_init(env, opt, args.models, trajopt, base)
                 why = learned_model_for(env, opt, init, trajopt) if learned else ""
                 if why:
                     notes.append(f"{env}: {name} initialiser skipped ({why})")

@@ -218,7 +218,6 @@ def test_the_shipped_fixed_duration_model_is_picked_and_named() -> None:
 def test_the_tracking_bench_runs_it_and_names_its_model() -> None:
     bench = load_benchmark("bench_tracking")
     init = bench.learned_init("double_pallet", True, None, name=NAME)
-    assert init == NAME
     assert bench.learned_model_for("double_pallet", True, init) == ""
     assert bench.learned_model_name("double_pallet", True, init) == (
         "anymal_c_double_pallet_walk20_swing05"
@@ -260,3 +259,40 @@ def test_learned_without_an_optimised_duration_model_points_to_this_initialiser(
     assert "learned_fixed_durations" not in bench.learned_model_for(
         "single_pallet", False, "learned", low
     )
+
+
+def test_constraints_appended_after_the_model_s_are_taken_with_zero_multipliers(
+    tmp_path: Path, flat: TerrainModel, solved: tuple[TrajoptProblem, TrajoptProblem, object]
+) -> None:
+    _, optimised, result = solved
+    base = optimised.formulation.config.constraints
+    extra = "unilateral_between_nodes"
+    assert extra not in base
+    config = melon_config(
+        steps=STEPS,
+        duration=DURATION,
+        optimize_durations=True,
+        phase_duration_bounds=WIDE,
+        constraints=(*base, extra),
+    )
+    nlp = TrajoptProblem(TOWR_ANYMAL, flat, make_gait("walk", STEPS, DURATION), config).formulation
+    lam_g = np.asarray(result.lam_g)  # type: ignore[attr-defined]
+    mapped = to_optimised_rows(nlp, lam_g)
+    assert mapped is not None and mapped.size == nlp.n_constraints
+    where = nlp.row_slices()[extra]
+    assert where.stop == nlp.n_constraints and not mapped[where].any()
+    np.testing.assert_array_equal(
+        mapped[: where.start], to_optimised_rows(optimised.formulation, lam_g)
+    )
+    # The initialiser takes such a problem, as learned does ...
+    model = heuristic_guess_model(constraints=[n for n in base if n not in DURATION_ROWS])
+    model.save(tmp_path / "tiny.npz")
+    init = f"{NAME}:{tmp_path / 'tiny.npz'}"
+    solve = optimize_motion("anymal_c", "flat", TASK, config=config, init=init, max_iter=0)
+    assert solve.x is not None and extra in solve.config["constraints"]
+    # ... but not one that changed the model's own set.
+    dropped = melon_config(
+        steps=STEPS, duration=DURATION, optimize_durations=True, constraints=base[1:]
+    )
+    with pytest.raises(ConfigError, match="optionally followed by others"):
+        optimize_motion("anymal_c", "flat", TASK, config=dropped, init=init, max_iter=0)

@@ -48,6 +48,9 @@ def test_a_folder_resumes_under_another_limit_and_keeps_its_solves(tmp_path: Pat
     assert statuses[0] == "timeout"  # kept, not redone
     assert statuses[1] != "timeout"
     assert json.loads((tmp_path / "run" / "run.json").read_text())["time_limit_s"] == 400.0
+    # Resumed under the problem's own limit, the record says so (null), not 400 s.
+    _statuses(tmp_path / "run", 2, None)
+    assert json.loads((tmp_path / "run" / "run.json").read_text())["time_limit_s"] is None
 
 
 @pytest.mark.parametrize("bad", [0.0, -1.0, float("nan")])
@@ -70,3 +73,26 @@ def test_the_cli_passes_time_limit_to_every_solve(tmp_path: Path) -> None:
     (solve,) = (out / "solves").glob("*.npz")
     with np.load(solve) as row:
         assert str(row["status"]) == "timeout"
+
+
+def test_a_model_of_another_problem_is_refused_before_the_folder_is_made(tmp_path: Path) -> None:
+    from dataclasses import replace
+
+    from _learned_models import heuristic_guess_model
+
+    with pytest.raises(ConfigError, match="does not fit"):
+        generate(
+            replace(SPEC, optimize_durations=True),
+            task_space("flat"),
+            1,
+            tmp_path / "run",
+            model=heuristic_guess_model(),
+            progress=None,
+        )
+    assert not (tmp_path / "run").exists()
+    code = main(
+        ["init", "generate", "--env", "flat", "--tasks", "1", "--optimize-durations"]
+        + ["--init", "learned_fixed_durations", "--out", str(tmp_path / "cli")]
+    )
+    assert code != 0
+    assert not (tmp_path / "cli").exists()

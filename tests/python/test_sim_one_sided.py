@@ -98,7 +98,7 @@ def test_a_side_carrying_nothing_with_four_feet_down_fires_the_one_sided_reflex(
 
 @pytest.mark.skipif(not HAVE_PLANNER, reason="the compiled core has no FootstepPlanner")
 @pytest.mark.parametrize("terrain", ["flat", "large_rocks:seed=1,max_height=0.05"])
-def test_a_walk_undisturbed_fires_no_one_sided_reflex(littledog, terrain: str) -> None:
+def test_a_walk_undisturbed_with_the_check_on_fires_no_reflex(littledog, terrain: str) -> None:
     ground = roughwalk.load_terrain(terrain)
     result = run(
         littledog,

@@ -99,3 +99,18 @@ def test_a_folder_without_a_fitting_model_is_reported_not_replaced(candidate: Pa
     init = bench.learned_init("single_pallet", False, candidate)
     assert init == f"learned:{candidate}"
     assert bench.learned_model_for("single_pallet", False, init) != ""
+
+
+def test_a_job_whose_model_cannot_be_loaded_is_a_failed_row_not_a_crash(tmp_path: Path) -> None:
+    bench = load_benchmark("bench_tracking")
+    terrain, tasks, _ = bench.held_out_tasks("flat", 1, 0)
+    task = tasks[0]
+    missing = f"learned:{tmp_path / 'missing.npz'}"
+    job = bench.Job(
+        "flat", terrain, missing, 0, False, 0, task.start, task.goal, (), None, (), (), None
+    )
+    row = bench.run_job(job)
+    assert row["success"] is False
+    assert row["reason"].startswith("solve raised ConfigError")
+    assert "missing.npz" in row["reason"]
+    assert row["model"] is None

@@ -87,7 +87,8 @@ def register(sub: Any) -> None:
         type=float,
         metavar="SECONDS",
         help="IPOPT's wall-time limit per solve (default: the solver's, 40 s); raise it on a "
-        "busy machine, where a solve can stop on time before its iteration limit",
+        "busy machine, where a solve can stop on time before its iteration limit (a solve "
+        "that stopped on time stays done when the folder is resumed)",
     )
     g.add_argument(
         "--init",
@@ -209,7 +210,14 @@ def cmd_generate(args: argparse.Namespace) -> int:
     model = None
     max_iter = args.max_iter
     if args.init != "heuristic" and seeds is None:
+        from roughwalk.errors import InvalidArgumentError
         from roughwalk.learning.initializer import model_for_spec
+
+        if args.init.partition(":")[0] != "learned":
+            raise InvalidArgumentError(
+                f"--init {args.init}: experience starts from heuristic, learned[:MODEL] or "
+                f"nearest:RUN[,RUN...] (a learned start's model must be of this problem)"
+            )
 
         model = model_for_spec(args.init, spec)
         max_iter = 25 if max_iter is None else max_iter

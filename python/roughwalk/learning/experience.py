@@ -425,7 +425,8 @@ def generate(
         ``solver.time_limit_s``. It changes no iterate, only where a slow
         solve stops (its row's status is then "timeout"), so it is not part
         of what a resumed folder must match; the run records the last one
-        used as "time_limit_s".
+        used as "time_limit_s" (null: the problem's). A solve that stopped on
+        time is kept as done: re-solve it in a fresh folder.
 
     Returns
     -------
@@ -440,6 +441,10 @@ def generate(
         )
     if time_limit_s is not None and not time_limit_s > 0:
         raise ConfigError(f"time_limit_s must be > 0 seconds, got {time_limit_s}")
+    if model is not None:
+        # Its guesses must be of this NLP (a fixed-duration model's are shorter
+        # than an optimised-duration problem's): refused before the folder is made.
+        model.check_signature(spec.to_dict())
     if seeds is not None and model is not None:
         raise ConfigError("a run starts from a model's guesses or from seed runs' solves, not both")
     if seeds is not None:
@@ -467,9 +472,11 @@ def generate(
         },
         unrecorded={"solver": UNRECORDED_SOLVE_SETTINGS},
     )
-    if time_limit_s is not None:
-        # What the solves stop at on this machine, not what the folder solves.
-        run.meta["time_limit_s"] = float(time_limit_s)
+    # What the solves stop at on this machine (None: the problem's limit), not
+    # what the folder solves; a solve that stopped on time stays done.
+    limit = None if time_limit_s is None else float(time_limit_s)
+    if run.meta.get("time_limit_s", None) != limit:
+        run.meta["time_limit_s"] = limit
         run._write_meta()
     wanted = list(range(n_tasks)) if indices is None else sorted(set(indices))
     # Tasks the problem refuses (a start no solve can leave) are not solved:

@@ -155,21 +155,26 @@ def gait_durations(nlp: Formulation) -> list[NDArray[np.float64]]:
 def to_optimised_rows(nlp: Formulation, lam_g: NDArray[np.float64]) -> NDArray[np.float64] | None:
     """Constraint multipliers of the fixed-duration NLP in ``nlp``'s rows, or None.
 
-    The fixed NLP's rows are ``nlp``'s blocks without :data:`DURATION_ROWS`;
-    those rows get 0. None when ``lam_g`` has another length (the rows do
-    not correspond; no multiplier warm start).
+    The fixed NLP's rows are ``nlp``'s blocks without :data:`DURATION_ROWS`,
+    in order; those rows get 0, and so do blocks appended after the fixed
+    NLP's (a constraint the model was not trained with). None when
+    ``lam_g`` does not end on a block boundary (the rows do not correspond;
+    no multiplier warm start).
     """
     lam_g = np.asarray(lam_g, dtype=float)
-    fixed = sum(size for name, size in nlp.row_layout if name not in DURATION_ROWS)
-    if lam_g.size != fixed:
+    if lam_g.size == 0:
         return None
     parts, at = [], 0
     for name, size in nlp.row_layout:
-        if name in DURATION_ROWS:
+        if name in DURATION_ROWS or at == lam_g.size:
             parts.append(np.zeros(size))
-        else:
-            parts.append(lam_g[at : at + size])
-            at += size
+            continue
+        if at + size > lam_g.size:
+            return None
+        parts.append(lam_g[at : at + size])
+        at += size
+    if at != lam_g.size:
+        return None
     return np.concatenate(parts)
 
 
@@ -204,14 +209,16 @@ class FixedDurationsInitializer(LearnedInitializer):
     def constraints(
         self, requested: tuple[str, ...], signature: dict[str, object]
     ) -> tuple[str, ...]:
-        """The fixed-duration model's constraint set (``total_duration`` is in it; see base)."""
-        self._model(dict(signature))
-        return super().constraints(requested, signature)
+        """The fixed-duration model's constraint set (see base), with :data:`DURATION_ROWS`.
 
-    def costs(self, requested: Any, signature: dict[str, object]) -> Any:
-        """The fixed-duration model's recorded cost weights (see base)."""
-        self._model(dict(signature))
-        return super().costs(requested, signature)
+        A fixed-duration model may have been trained without ``total_duration``
+        (it has no rows then); the optimised NLP needs it, or each foot's
+        last phase would be unbounded, so it is appended when missing.
+        """
+        chosen = super().constraints(requested, signature)
+        if signature.get("optimize_durations"):
+            chosen += tuple(n for n in DURATION_ROWS if n not in chosen)
+        return chosen
 
     def guess(self, nlp: Formulation, task: ResolvedTask) -> NDArray[np.float64]:
         """The model's guess mapped into ``nlp``, within its bounds; refuses a mismatch."""
@@ -243,21 +250,6 @@ class FixedDurationsInitializer(LearnedInitializer):
             at += v.size
         return bounds, rows
 
-    def has_fallback(self, nlp: Formulation) -> bool:
-        """Whether the fixed-duration model has a solution library (see base)."""
-        self._model(problem_signature(nlp))
-        return super().has_fallback(nlp)
-
-    def cost_limit(self, nlp: Formulation, task: ResolvedTask) -> float | None:
-        """The fixed-duration model's per-task g_max.
-
-        Freeing the durations can only lower the optimum (the gait's durations,
-        a clamped phase aside, are a point of the optimised NLP), so a solve
-        that ends above it is still a poor minimum.
-        """
-        self._model(problem_signature(nlp))
-        return super().cost_limit(nlp, task)
-
     def fallback(
         self, nlp: Formulation, task: ResolvedTask
     ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None, NDArray[np.float64] | None]:
@@ -280,16 +272,22 @@ class FixedDurationsInitializer(LearnedInitializer):
 
     @staticmethod
     def _check_constraints(nlp: Formulation, model: LearnedModel) -> None:
-        """Refuse an NLP whose constraint set is not the model's (besides duration rows)."""
+        """Refuse an NLP whose constraint set does not start with the model's.
+
+        As for ``learned``, constraints appended after the model's set are
+        taken (their multipliers start at 0); :data:`DURATION_ROWS` are left
+        out of the comparison (the fixed NLP has no rows for them).
+        """
         recorded = recorded_constraints(model)
         if recorded is None:
             return
         ours = [n for n in nlp.config.constraints if n not in DURATION_ROWS]
         theirs = [n for n in recorded if n not in DURATION_ROWS]
-        if ours != theirs:
+        if ours[: len(theirs)] != theirs:
             raise ConfigError(
                 f"learned model '{model.name}' was trained on constraints {theirs}; this NLP "
-                f"has {ours}: its guess does not map ({NAME} needs the model's set)"
+                f"has {ours}: its guess does not map ({NAME} needs the model's set, "
+                f"optionally followed by others)"
             )
 
 

@@ -151,6 +151,12 @@ class LearnedInitializer:
         """The task as given."""
         return task
 
+    def _model(self, signature: dict[str, object]) -> LearnedModel:
+        """The model, picked on first use from the shipped ones that fit ``signature``."""
+        if self.model is None:
+            self.model = _pick(signature)
+        return self.model
+
     def source(self) -> str | None:
         """The model the guess comes from (None before one is chosen), for the result's message."""
         return None if self.model is None else f"learned model '{self.model.name}'"
@@ -163,9 +169,7 @@ class LearnedInitializer:
         ``signature`` is the problem's (:func:`problem_signature` without the
         layout), to pick the shipped model; see :mod:`.model_constraints`.
         """
-        if self.model is None:
-            self.model = _pick(signature)
-        return constraints_for_model(self.model, requested)
+        return constraints_for_model(self._model(signature), requested)
 
     def costs(self, requested: CostWeights, signature: dict[str, object]) -> CostWeights:
         """The cost weights to solve with: the model's recorded ones where none was chosen.
@@ -173,34 +177,27 @@ class LearnedInitializer:
         A weight the configuration changed from the default is kept (the
         user's override wins); see :mod:`.model_costs`.
         """
-        if self.model is None:
-            self.model = _pick(signature)
-        return costs_for_model(self.model, requested)
+        return costs_for_model(self._model(signature), requested)
 
     def guess(self, nlp: Formulation, task: ResolvedTask) -> NDArray[np.float64]:
         """A_θ(task), within the NLP's variable bounds; refuses a problem the model does not fit."""
         signature = problem_signature(nlp)
-        if self.model is None:
-            self.model = _pick(signature)
-        self.model.check_signature(signature)
-        return np.clip(self.model.predict(task.task), nlp.lbx, nlp.ubx)
+        model = self._model(signature)
+        model.check_signature(signature)
+        return np.clip(model.predict(task.task), nlp.lbx, nlp.ubx)
 
     def multipliers(
         self, nlp: Formulation, task: ResolvedTask
     ) -> tuple[NDArray[np.float64] | None, NDArray[np.float64] | None]:
         """A_θ's multipliers (lam_x, lam_g) for IPOPT's warm start, or (None, None)."""
-        if self.model is None:
-            self.model = _pick(problem_signature(nlp))
-        lam_x, lam_g = self.model.predict_multipliers([task.task])
+        lam_x, lam_g = self._model(problem_signature(nlp)).predict_multipliers([task.task])
         if lam_x is None or lam_g is None:
             return None, None
         return lam_x[0], _complete_rows(nlp, lam_g[0])
 
     def has_fallback(self, nlp: Formulation) -> bool:
         """Whether :meth:`fallback` differs from the guess: the model has a solution library."""
-        if self.model is None:
-            self.model = _pick(problem_signature(nlp))
-        return self.model.library is not None
+        return self._model(problem_signature(nlp)).library is not None
 
     def fallback(
         self, nlp: Formulation, task: ResolvedTask
@@ -212,9 +209,7 @@ class LearnedInitializer:
         average over neighbours, in no one basin) often converges: see
         ``solver.guess_fallback_after``.
         """
-        if self.model is None:
-            self.model = _pick(problem_signature(nlp))
-        network = self.model.network_only()
+        network = self._model(problem_signature(nlp)).network_only()
         x0 = np.clip(network.predict(task.task), nlp.lbx, nlp.ubx)
         lam_x, lam_g = network.predict_multipliers([task.task])
         if lam_x is None or lam_g is None:
@@ -228,9 +223,7 @@ class LearnedInitializer:
         :meth:`other_start` (``solver.dear_guess_restarts``); None (a model
         without a task cost model) never restarts.
         """
-        if self.model is None:
-            self.model = _pick(problem_signature(nlp))
-        limits = self.model.cost_limits([task.task])
+        limits = self._model(problem_signature(nlp)).cost_limits([task.task])
         return None if limits is None else float(limits[0])
 
     def other_start(
@@ -240,11 +233,8 @@ class LearnedInitializer:
 
         None when the model has no library or every candidate was tried.
         """
-        if self.model is None:
-            self.model = _pick(problem_signature(nlp))
-        return choose_start(
-            nlp, self.model.other_starts(task.task), visited, self.model.mlp.out_scale
-        )
+        model = self._model(problem_signature(nlp))
+        return choose_start(nlp, model.other_starts(task.task), visited, model.mlp.out_scale)
 
 
 def choose_start(

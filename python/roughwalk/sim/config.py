@@ -447,38 +447,13 @@ class ReflexConfig:
         the other side, faster than
         ``one_sided_rate_rad_s`` [rad/s] for ``one_sided_persist_s`` [s]
         (:func:`~roughwalk.sim.reflexes.tipping_off`). Neither foot check
-        sees it with four feet planned down (the load sharing is
-        indeterminate), so on the 1 N·s right push at 1.8 s
-        (``bench_push_recovery.py --direction -90``) only the orientation
-        error fired (2.284 s), 0.14 s after the left feet let go; this
-        fires at 2.146 s (0.34 rad/s, roll 0.7°), and at 1.984 s on the
-        1.6 s push (the foot-force reflex: 2.010 s). Caught sooner, both
-        still fall (2.44 and 2.67 s; 2.44 and 2.51 s without): the centre
-        of mass has 0.12–0.2 m/s towards the loaded feet's line while the
-        push still acts, and no response tried holds it. Session 19
-        (s19-oneside), one run per push time: pressing the left feet 1 or
-        2 cm into the ground from the measured trunk instead of a reflex
-        rolls the robot over faster (falls at 2.26 and 2.35 s: the ground
-        pushes the rising side up); the reflex with a loaded right foot
-        also stepped out by the capture offset falls at 2.40–2.41 and
-        2.35–2.58 s; a version watching diagonals too (every loaded foot
-        on a diagonal, the planned-down feet off it on one side) loses
-        the 2.0 s right push (it fires 0.07 s before the three-foot
-        foot-force check, whose later capture step of the swinging RH goes
-        4 cm further out: 6/9 right) and rescues the 1.6 s left one (9/9 left).
-        Sides only: the 1 N·s sweeps (``--from 1.6 --to 3.2``) survive
-        the same push times as without, 7/9 right and 8/9 left; large
-        rocks seeds 0–11 (``bench_littledog.py --expansions 40000``) 7/12
-        at 5.50 cm/s as without, the seven won runs the same to the
-        millisecond. It fires in seeds 6 and 11 only, sooner than the
-        reflex that ended main's run (seed 11: 2.56 s, RF unloaded, where
-        main's foot-force reflex at 2.75 s led to a roll at 3.24 s; seed
-        6: 3.30 s, before a foot-position reflex whose re-plan had no
-        plan): both robots survive that recovery and walk on, then meet
-        the state again and again (4 and 2 more one-sided reflexes) and
-        roll over at 5.96 and 5.32 s. Seeds 4 and 10 fall in recoveries,
-        where no reflex watches (on a diagonal, RF sliding 5 cm down its
-        flank). Off: no run gained.
+        sees this state with four feet planned down. Trade-off: it fires
+        sooner (0.14 s on the 1 N·s right push at 1.8 s), but the recovery
+        it starts saves no run: the 1 N·s side-push sweeps keep 7/9 right
+        and 8/9 left, large rocks seeds 0–11 7/12 at 5.50 cm/s, as without;
+        the responses tried with it (pressing the unloaded feet down,
+        stepping a loaded foot out, watching diagonals too) lose runs.
+        Session 19's figures and the why: ``docs/measurements.md``.
     one_sided_rate_rad_s, one_sided_persist_s, one_sided_loaded_n:
         See ``one_sided``; a foot bearing more than ``one_sided_loaded_n``
         [N] counts as loaded.

@@ -111,8 +111,9 @@ def tipping_off(
     load, ``feet`` (4, 3) [m] where they are, ``angvel`` (3,) [rad/s] the
     trunk's angular velocity (world axes). When every loaded foot is on
     one side (:data:`SIDES`) and a foot of the other side is planned down
-    (bearing nothing), the rate is the trunk's rotation about the line of
-    the loaded side's feet in the sense that lifts the other side
+    (bearing nothing), the rate is the trunk's rotation about the line
+    through that side's two feet (the support polygon's edge there, whether
+    one or both of them bear the load) in the sense that lifts the other side
     (negative: it comes down), with the leg of a planned-down foot there.
     (0, None) in any other state.
 

@@ -55,7 +55,10 @@ class Initializer(Protocol):
 
 # name → factory(argument after the colon, or None)
 _REGISTRY: dict[str, Callable[[str | None], Initializer]] = {}
-_PROVIDERS = {"learned": "roughwalk.learning (the learned-initialisation issue)"}
+_PROVIDERS = {
+    "learned": "roughwalk.learning (the learned-initialisation issue)",
+    "learned_fixed_durations": "roughwalk.learning (the learned-initialisation issue)",
+}
 
 
 def register_initializer(name: str, factory: Callable[[str | None], Initializer]) -> None:
