@@ -29,6 +29,11 @@ def seed_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return folder
 
 
+def _grown(seed_run: Path, folder: Path, n: int, **kw: Any) -> Any:
+    """The first ``n`` tasks of SPACE grown from ``seed_run``'s solves into ``folder``."""
+    return generate(SPEC, SPACE, n, folder, progress=None, max_iter=LIMIT, seeds=[seed_run], **kw)
+
+
 def _scaled(a: np.ndarray, b: np.ndarray) -> float:
     scale = np.array([0.2, 0.2, 0.4, 1.0, 1.0, 1.0])
     return float(np.sqrt((((a - b) / scale) ** 2).sum()))
@@ -41,16 +46,7 @@ def test_each_task_starts_from_the_nearest_solve_so_far_nearest_first(
     rows = zip(seed["start"], seed["goal"], seed["x"], strict=True)
     pool = [(np.concatenate([start, goal]), x) for start, goal, x in rows]
     order: list[dict[str, Any]] = []
-    data = generate(
-        SPEC,
-        SPACE,
-        6,
-        tmp_path / "grown",
-        progress=None,
-        max_iter=LIMIT,
-        seeds=[seed_run],
-        on_solved=order.append,
-    )
+    data = _grown(seed_run, tmp_path / "grown", 6, on_solved=order.append)
     assert sorted(int(r["index"]) for r in order) == list(range(6))
     for row in order:
         task = np.concatenate([row["start"], row["goal"]])
@@ -115,14 +111,5 @@ def test_only_feasible_solves_with_multipliers_join_the_pool() -> None:
 def test_a_time_limit_reaches_the_solves_started_from_neighbours(
     seed_run: Path, tmp_path: Path
 ) -> None:
-    data = generate(
-        SPEC,
-        SPACE,
-        3,
-        tmp_path / "grown",
-        progress=None,
-        max_iter=LIMIT,
-        seeds=[seed_run],
-        time_limit_s=1e-6,
-    )
+    data = _grown(seed_run, tmp_path / "grown", 3, time_limit_s=1e-6)
     assert [str(s) for s in data["status"]] == ["timeout"] * 3
