@@ -141,6 +141,37 @@ def test_an_out_of_bounds_phase_is_clamped_and_the_next_absorbs_it(
     assert _violation(nlp, mapped, p) < 0.8 * at_start
 
 
+def test_with_bounds_that_admit_the_gait_the_mapping_is_exact_at_towr_s_bounds(
+    flat: TerrainModel, solved: tuple[TrajoptProblem, TrajoptProblem, object]
+) -> None:
+    # TOWR's 0.2–1.0 s clamps the walk's 1.24 s front-right stance; with
+    # phase_bounds_admit_gait nothing is clamped, and the converged fixed
+    # solve mapped meets the optimised rows and objective as it met the fixed
+    # NLP's (as with bounds wide enough for every phase).
+    fixed, _, result = solved
+    config = melon_config(
+        steps=STEPS,
+        duration=DURATION,
+        optimize_durations=True,
+        phase_bounds_admit_gait=True,
+    )
+    admitted = TrajoptProblem(TOWR_ANYMAL, flat, make_gait("walk", STEPS, DURATION), config)
+    nlp = admitted.formulation
+    gait = make_gait("walk", STEPS, DURATION)
+    for d, timed, own in zip(nlp.durations, gait_durations(nlp), gait.durations, strict=True):
+        np.testing.assert_allclose(timed, own, atol=1e-12)
+        assert d.bounds[0] == 0.2 and d.bounds[1] >= 1.0
+    assert max(max(own[:-1]) for own in gait.durations) > 1.0  # something was clamped before
+    x = result.x  # type: ignore[attr-defined]
+    p = resolve(TASK, TOWR_ANYMAL, flat).vector()
+    mapped = to_optimised_variables(nlp, x)
+    assert np.all((nlp.lbx <= mapped) & (mapped <= nlp.ubx))
+    met = _violation(fixed.formulation, x, p)
+    assert _violation(nlp, mapped, p) <= max(met, 1e-9) * 1.0001
+    f_fixed = float(fixed.formulation.evaluator(x, p)[0])
+    assert float(nlp.evaluator(mapped, p)[0]) == pytest.approx(f_fixed, 1e-9)
+
+
 def test_the_guess_through_optimize_motion_is_the_model_s_in_the_optimised_layout(
     tmp_path: Path, flat: TerrainModel
 ) -> None:

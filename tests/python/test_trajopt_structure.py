@@ -27,6 +27,7 @@ from roughwalk.trajopt.variables import (
     hermite_point,
     sample_points,
 )
+from roughwalk.trajopt.variables.phase_durations import ADMIT_MARGIN
 
 
 @pytest.fixture(scope="module")
@@ -255,6 +256,55 @@ def test_polynomial_windows_hold_every_admissible_schedule() -> None:
                     lo, hi = durations.poly_window(phase, j, m)
                     start = starts[phase] + j * d[phase] / m
                     assert lo - 1e-9 <= start and start + d[phase] / m <= hi + 1e-9
+
+
+def test_bounds_that_admit_the_nominal_phases_widen_only_theirs_and_keep_windows() -> None:
+    # 16-step walk in 5.5 s: the front-right foot's first stance (1.079 s)
+    # is beyond TOWR's 1.0 s. Admitted, that phase alone is widened to it;
+    # every polynomial of every schedule within the per-phase bounds still
+    # starts and ends inside its window (the windows assume the widest phase).
+    gait = make_gait("walk", 16, 5.5)
+    foot = next(f for f, d in enumerate(gait.durations) if max(d[:-1]) > 1.0)
+    nominal = list(gait.durations[foot])
+    plain = PhaseDurations(foot, nominal, (0.2, 1.0), optimize=True)
+    admitted = PhaseDurations(foot, nominal, (0.2, 1.0), optimize=True, admit_nominal=True)
+    own = np.asarray(nominal[:-1])
+    wide = own > 1.0
+    assert wide.sum() == 1 and own[wide][0] == pytest.approx(1.079, abs=1e-3)
+    np.testing.assert_allclose(admitted.upper[wide], own[wide] + ADMIT_MARGIN)
+    np.testing.assert_array_equal(admitted.upper[~wide], plain.upper[~wide])
+    np.testing.assert_array_equal(admitted.lower, plain.lower)
+    assert admitted.bounds == (0.2, pytest.approx(own.max() + ADMIT_MARGIN))
+    # The gait is feasible and off every bound (IPOPT would push it inside).
+    assert np.all((admitted.lower < own - 1e-3) & (own + 1e-3 < admitted.upper))
+    n, total = len(nominal), sum(nominal)
+    rng = np.random.default_rng(4)
+    checked = 0
+    while checked < 300:
+        free = rng.uniform(admitted.lower, admitted.upper)
+        if rng.random() < 0.3:
+            free = np.where(rng.random(n - 1) < 0.5, admitted.lower, admitted.upper)
+        if free.sum() > total:
+            continue
+        checked += 1
+        d = np.append(free, total - free.sum())
+        starts = np.concatenate([[0.0], np.cumsum(d)[:-1]])
+        for m in (1, 2, 3):
+            for phase in range(n):
+                for j in range(m):
+                    lo, hi = admitted.poly_window(phase, j, m)
+                    start = starts[phase] + j * d[phase] / m
+                    assert lo - 1e-9 <= start and start + d[phase] / m <= hi + 1e-9
+    # Through the formulation: the NLP starts from the gait itself, not a fitted schedule.
+    nlp = Formulation(
+        towr_config(optimize_durations=True, phase_bounds_admit_gait=True),
+        TOWR_ANYMAL,
+        gait,
+        TerrainModel(load_terrain("flat")),
+    )
+    for d, own_durations in zip(nlp.durations, gait.durations, strict=True):
+        assert d.nominal == list(own_durations)
+        assert np.all((d.lower <= d.nominal[:-1]) & (np.asarray(d.nominal[:-1]) <= d.upper))
 
 
 def test_optimised_durations_give_the_fixed_problem_at_equal_durations(flat: TerrainModel) -> None:

@@ -136,15 +136,15 @@ def gait_durations(nlp: Formulation) -> list[NDArray[np.float64]]:
     every later phase boundary keeps its time in the gait: on the 16-step
     walk in 5.5 s, the front-right foot's first stance (1.079 s) ends at
     1.0 s and its first swing starts that much earlier; every other phase
-    boundary is the gait's.
+    boundary is the gait's. With ``phase_bounds_admit_gait`` every phase is
+    in its own bounds and nothing is clamped: the gait's durations exactly.
     """
     gait = make_gait(nlp.config.gait, nlp.config.steps, nlp.config.duration)
     out = []
     for d, own in zip(nlp.durations, gait.durations, strict=True):
-        lo, hi = d.bounds
         ends = np.cumsum(own)
         timed, start = [], 0.0
-        for end in ends[: d.size]:
+        for end, lo, hi in zip(ends[: d.size], d.lower, d.upper, strict=True):
             timed.append(float(np.clip(end - start, lo, hi)))
             start += timed[-1]
         timed.append(float(d.total - start))

@@ -260,8 +260,9 @@ class Formulation:
         terrain: TerrainModel,
         compiled: CompiledNlp | None = None,
     ) -> None:
-        if config.optimize_durations:
-            # Optimised durations start inside their bounds (see ContactSchedule.fitted).
+        if config.optimize_durations and not config.phase_bounds_admit_gait:
+            # Optimised durations start inside their bounds (see ContactSchedule.fitted);
+            # bounds that admit the gait hold its own schedule already.
             schedule = schedule.fitted(config.phase_duration_bounds)
         self.config = config
         self.body = body
@@ -276,7 +277,11 @@ class Formulation:
         self.base_ang = BaseAngular(base_durations)
         self.durations = [
             PhaseDurations(
-                f, schedule.durations[f], config.phase_duration_bounds, config.optimize_durations
+                f,
+                schedule.durations[f],
+                config.phase_duration_bounds,
+                config.optimize_durations,
+                admit_nominal=config.phase_bounds_admit_gait,
             )
             for f in range(schedule.n_feet)
         ]
