@@ -242,6 +242,32 @@ def test_generate_cli_selects_far_starts_and_checks_jitter(
     assert not (tmp_path / "bad" / "dataset.npz").exists()
 
 
+def test_generate_cli_first_task_gives_fresh_tasks_that_aggregate(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--first-task K`` solves tasks K..K+N−1 of the same stream: the tasks a run of
+    K+N tasks would solve there, none of the first run's, and ``init train`` merges
+    both runs into one dataset (Algorithm 1's aggregate of rounds)."""
+    from roughwalk.cli.main import main
+    from roughwalk.learning.task_space import ENVIRONMENTS
+    from roughwalk.learning.training import load_datasets
+
+    common = ["init", "generate", "--env", "flat", "--steps", "4", "--duration", "2.0"]
+    common += ["--max-iter", "0", "--tasks", "3"]
+    assert main([*common, "--out", str(tmp_path / "first")]) == 0
+    assert main([*common, "--first-task", "3", "--out", str(tmp_path / "fresh")]) == 0
+    fresh = read_run(tmp_path / "fresh")
+    assert fresh["index"].tolist() == [3, 4, 5]
+    space = ENVIRONMENTS["flat"]
+    assert np.array_equal(fresh["start"], [space.task(i).start for i in (3, 4, 5)])
+    merged = load_datasets([tmp_path / "first", tmp_path / "fresh"])
+    assert merged["index"].tolist() == [0, 1, 2, 3, 4, 5]
+    capsys.readouterr()
+    assert main([*common, "--first-task", "-1", "--out", str(tmp_path / "bad")]) == 1
+    assert "--first-task and --tasks must be >= 0" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()
+
+
 def test_a_run_leaves_out_the_tasks_the_problem_refuses(tmp_path: Path) -> None:
     # Starts at held-out single-pallet task 189's: near the edge, turned right, one
     # front foot up the smoothed edge beyond its range of motion on some of them.

@@ -79,6 +79,14 @@ def register(sub: Any) -> None:
     _problem_args(g)
     _executor_args(g)
     g.add_argument("--tasks", type=int, default=2000, help="number of tasks (default 2000)")
+    g.add_argument(
+        "--first-task",
+        type=int,
+        default=0,
+        help="index of the first task of the stream (default 0): --tasks 1000 --first-task 1000 "
+        "solves tasks 1000..1999, fresh tasks for another round with the same seed, so that "
+        "init train can aggregate both runs",
+    )
     g.add_argument("--split", default="train", choices=("train", "test"), help="task stream")
     g.add_argument("--seed", type=int, default=0, help="task sampling seed")
     g.add_argument("--max-iter", type=int, help="IPOPT iterations (default 100, N_h)")
@@ -108,12 +116,14 @@ def register(sub: Any) -> None:
     g.add_argument(
         "--start-x-max",
         type=float,
-        help="solve only the tasks (of the first --tasks) whose start x is at most this (m)",
+        help="solve only the tasks (of the --tasks from --first-task) whose start x is at most "
+        "this (m)",
     )
     g.add_argument(
         "--start-x-min",
         type=float,
-        help="solve only the tasks (of the first --tasks) whose start x is at least this (m)",
+        help="solve only the tasks (of the --tasks from --first-task) whose start x is at least "
+        "this (m)",
     )
     g.set_defaults(func=cmd_generate)
 
@@ -221,13 +231,20 @@ def cmd_generate(args: argparse.Namespace) -> int:
 
         model = model_for_spec(args.init, spec)
         max_iter = 25 if max_iter is None else max_iter
-    indices = None
+    if args.first_task < 0 or args.tasks < 0:
+        from roughwalk.errors import InvalidArgumentError
+
+        raise InvalidArgumentError(
+            f"--first-task and --tasks must be >= 0, got {args.first_task} and {args.tasks}"
+        )
+    span = range(args.first_task, args.first_task + args.tasks)
+    indices = None if args.first_task == 0 else list(span)
     if args.start_x_max is not None or args.start_x_min is not None:
         low = -math.inf if args.start_x_min is None else args.start_x_min
         high = math.inf if args.start_x_max is None else args.start_x_max
         indices = [
             i
-            for i in range(args.tasks)
+            for i in span
             if low <= space.task(i, seed=args.seed, split=args.split).start[0] <= high
         ]
     executor = make_executor(args.executor, workers=args.workers, address=args.address)
