@@ -47,6 +47,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -64,7 +65,14 @@ from roughwalk.cli.common import (
 from roughwalk.sim import FrictionDrop, MapError, Push, run
 
 RESULTS = Path(__file__).resolve().parent / "results" / "littledog.json"
-SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "terrains" / "littledog"
+# The shared data folder beside the checkout, or $ROUGHWALK_SHARED (a worktree elsewhere).
+SHARED = (
+    Path(
+        os.environ.get("ROUGHWALK_SHARED") or Path(__file__).resolve().parents[1].parent / "shared"
+    )
+    / "terrains"
+    / "littledog"
+)
 BOARDS = {"large_rocks": "AE", "round_rocks": "AC", "sloped_rocks": "Y", "logs": "AD"}
 CLASSES = ("large_rocks", "round_rocks", "sloped_rocks", "logs", "gap", "barrier", "steps")
 TARGET_CM_S = 7.2
@@ -354,6 +362,13 @@ def main(argv: list[str] | None = None) -> int:
         ]
         args.set = [*budget, *args.set]  # the user's --set still wins
         args.plan_time = BUDGET_TIME_LIMIT_S
+    on_boards = [k for k in args.classes.split(",") if k in BOARDS]
+    if on_boards and not SHARED.is_dir():
+        print(
+            f"note: the LittleDog boards are not at {SHARED} (set ROUGHWALK_SHARED to the "
+            f"shared data folder): {', '.join(on_boards)} walk generated courses instead",
+            file=sys.stderr,
+        )
     try:
         sim_sets, traj_sets = simulation_settings(args.set)
     except rw.ConfigError as e:

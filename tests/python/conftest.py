@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Iterator
 from functools import cache
 from pathlib import Path
@@ -11,7 +12,10 @@ import pytest
 import roughwalk
 from roughwalk.terrain import Terrain
 
-SHARED_DIR = Path(__file__).resolve().parents[2].parent / "shared"
+# ../shared beside the checkout, or $ROUGHWALK_SHARED (a worktree elsewhere).
+SHARED_DIR = Path(
+    os.environ.get("ROUGHWALK_SHARED") or Path(__file__).resolve().parents[2].parent / "shared"
+)
 LITTLEDOG_BOARDS = ("terrainA", "terrainAC", "terrainAD", "terrainAE", "terrainC", "terrainY")
 
 
