@@ -25,6 +25,10 @@ __all__ = [
 ]
 
 
+RECOVERY_SLIDE_RESPONSES = ("lower", "hold", "replant")
+"""What ``reflex.recovery_slide_m`` does with a foot that slid during a recovery."""
+
+
 def _positive(obj: object, names: tuple[str, ...], prefix: str) -> None:
     for name in names:
         v = getattr(obj, name)
@@ -661,6 +665,26 @@ class ReflexConfig:
         large rocks seed 4's second recovery on main (RF slid 0.17 s in,
         LF and RH still being lowered) and, with ``executor.start_max_slope``
         40°, its first (at the reflex only LF bore load, 1 N).
+    recovery_slide_bearing:
+        How many of the other three feet (0–3) must bear load for
+        ``recovery_slide_m`` to act on a slide. 3: only where they can
+        carry the trunk while the slid foot is put down again (session 17).
+        Fewer watches the recoveries that stand on a diagonal or one side,
+        where the slides that end runs happen: board AE, bench large rocks
+        seed 4's second recovery (2.44 s) stands on LF and RH while RF, bearing
+        nothing, slides 5.5 cm down its flank and the trunk rolls over the
+        diagonal (35° at 3.06 s); seed 10's first (1.39 s) as RF and RH slide.
+    recovery_slide_response:
+        What a slide caught by ``recovery_slide_m`` does. "lower": the
+        recovery starts over, the slid foot put down again like a lifted
+        one (unweighted, onto ``replant_max_slope``'s nearest gentle
+        foothold or straight down); "hold": the recovery starts over with the
+        slid foot bearing where it now is, the trunk centred over the
+        measured stance; "replant": the trunk moves over the other three
+        feet, the slid foot steps onto the nearest gentle foothold (or on
+        along its slide onto the first flat ground within 2 cm) and the
+        trunk is centred again (:func:`~roughwalk.sim.recovery.replant_segments`;
+        "hold" where the other three cannot hold the trunk).
     max_reflexes:
         Give up (a failed run) after this many reflexes.
     end_at_goal:
@@ -709,6 +733,8 @@ class ReflexConfig:
     replant_certified: bool = True
     recovery_slide_m: float = 0.0
     recovery_slides: int = 2
+    recovery_slide_bearing: int = 3
+    recovery_slide_response: str = "lower"
     max_reflexes: int = 6
     end_at_goal: bool = True
 
@@ -754,6 +780,18 @@ class ReflexConfig:
         if self.settled_loaded_feet not in (3, 4) or isinstance(self.settled_loaded_feet, bool):
             raise ConfigError(
                 f"reflex.settled_loaded_feet must be 3 or 4, got {self.settled_loaded_feet!r}"
+            )
+        if self.recovery_slide_bearing not in (0, 1, 2, 3) or isinstance(
+            self.recovery_slide_bearing, bool
+        ):
+            raise ConfigError(
+                "reflex.recovery_slide_bearing must be 0, 1, 2 or 3, "
+                f"got {self.recovery_slide_bearing!r}"
+            )
+        if self.recovery_slide_response not in RECOVERY_SLIDE_RESPONSES:
+            raise ConfigError(
+                f"unknown reflex.recovery_slide_response {self.recovery_slide_response!r}; "
+                f"known: {', '.join(RECOVERY_SLIDE_RESPONSES)}"
             )
         if not (isinstance(self.recovery_slides, int) and self.recovery_slides >= 0):
             raise ConfigError(
