@@ -175,6 +175,28 @@ def test_a_slide_on_a_diagonal_is_caught_when_fewer_others_must_bear() -> None:
     assert sliding_leg(now, held, footholds, 0.015, 1.0, 0) == 1
 
 
+def test_a_foot_rising_off_its_foothold_is_no_slide() -> None:
+    # The 1 N·s left push at 2.2 s on flat ground: the roll lifts RH 1 cm off
+    # its foothold; caught as a slide and re-planted, the robot rolled over.
+    robot = rw.load_robot("littledog")
+    _, _, measured = _standing(robot, rw.load_terrain("flat"))
+    held = _level_pose(robot, measured, "recovery")
+    footholds = measured.feet.copy()
+    forces = np.zeros((4, 3))
+    forces[:, 2] = 8.0
+
+    def off(move: list[float]) -> int | None:
+        feet = footholds.copy()
+        feet[3] += move
+        now = dataclasses.replace(measured, feet=feet, foot_forces=forces)
+        return sliding_leg(now, held, footholds, 0.01, 1.0, 0)
+
+    assert off([0.0, 0.0, 0.012]) is None  # up
+    assert off([0.003, 0.0, 0.012]) is None  # up, 3 mm along
+    assert off([0.0, 0.0, -0.012]) == 3  # down a face
+    assert off([0.008, 0.0, -0.008]) == 3  # along and down
+
+
 # Board AE, bench large rocks seed 5 (``bench_littledog.py --expansions 40000
 # --set reflex.replant_max_slope=0.6981317 --set reflex.recovery_slide_m=0.015``):
 # the recovery after the first reflex (1.37 s) settled at 2.18 s with LH on a

@@ -484,7 +484,9 @@ def sliding_leg(
 
     Watched: the feet the recovery holds on their ``footholds`` (4, 3) [m]
     (desired supporting, within :data:`HELD_M` of them). The one farthest
-    beyond ``limit`` [m] counts if at least ``others_bearing`` (0–3) of the
+    beyond ``limit`` [m] along the ground or down (a foot rising off its
+    foothold does not count: on flat ground a side push's roll lifts one)
+    counts if at least ``others_bearing`` (0–3) of the
     other three each bear more than ``loaded_n`` [N]: with 3 they can carry
     the trunk while it is put down again; with fewer the slide is caught
     where the recovery stands on a diagonal or on one side (see
@@ -495,7 +497,11 @@ def sliding_leg(
     held = np.asarray(desired.support, dtype=bool) & (
         np.linalg.norm(np.asarray(desired.feet) - footholds, axis=1) < HELD_M
     )
-    off = np.where(held, np.linalg.norm(measured.feet - footholds, axis=1), 0.0)
+    # A slide moves the foot along the ground or down a face; a foot rising
+    # off its foothold (the trunk rolling away from it) is no slide.
+    moved = np.asarray(measured.feet, dtype=float) - footholds
+    moved[:, 2] = np.minimum(moved[:, 2], 0.0)
+    off = np.where(held, np.linalg.norm(moved, axis=1), 0.0)
     leg = int(np.argmax(off))
     if off[leg] <= limit:
         return None
