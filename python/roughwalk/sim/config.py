@@ -685,6 +685,14 @@ class ReflexConfig:
         along its slide onto the first flat ground within 2 cm) and the
         trunk is centred again (:func:`~roughwalk.sim.recovery.replant_segments`;
         "hold" where the other three cannot hold the trunk).
+    recovery_slide_drop_m:
+        With this [m] > 0, only a foot standing on the ground (within 1 cm)
+        that has dropped at least this below its recovery foothold counts
+        as sliding: one going down a rock's face. 0: any motion along the
+        ground or down. On flat ground a side push drags feet along the
+        ground or leaves a lowered foot short of its foothold, and re-planting
+        them there lost pushes main survives (1 N·s right push at 2.0 s: LF
+        1.5 cm up and 2.6 cm off, then LH dragged 3 cm; rolled 35° at 3.25 s).
     max_reflexes:
         Give up (a failed run) after this many reflexes.
     end_at_goal:
@@ -735,6 +743,7 @@ class ReflexConfig:
     recovery_slides: int = 2
     recovery_slide_bearing: int = 3
     recovery_slide_response: str = "lower"
+    recovery_slide_drop_m: float = 0.0
     max_reflexes: int = 6
     end_at_goal: bool = True
 
@@ -774,6 +783,7 @@ class ReflexConfig:
                 "replant_min_m",
                 "replant_margin_m",
                 "recovery_slide_m",
+                "recovery_slide_drop_m",
             ),
             "reflex",
         )

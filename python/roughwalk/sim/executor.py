@@ -774,6 +774,8 @@ class Executor:
             recently_loaded(self._last_loaded, now, _SLIDE_LOADED_WINDOW_S)
             if cfg.recovery_slide_bearing < 3
             else None,
+            cfg.recovery_slide_drop_m,
+            near_ground(self.robot, self.terrain_for_recovery, measured.feet),
         )
         if leg is None:
             self._slide_since = None

@@ -479,6 +479,8 @@ def sliding_leg(
     loaded_n: float,
     others_bearing: int = 3,
     loaded: NDArray[np.bool_] | None = None,
+    drop_m: float = 0.0,
+    on_ground: NDArray[np.bool_] | None = None,
 ) -> int | None:
     """A foot sliding off its recovery foothold while the others bear load, else None.
 
@@ -492,7 +494,11 @@ def sliding_leg(
     where the recovery stands on a diagonal or on one side (see
     ``ReflexConfig.recovery_slide_bearing``). ``loaded`` (4,): the feet
     that count as bearing instead (a foot chattering on a rock face bears
-    every few ticks, :func:`recently_loaded`).
+    every few ticks, :func:`recently_loaded`). ``drop_m`` [m] > 0: only a
+    foot that stands on the ground (``on_ground`` (4,), :func:`near_ground`)
+    and has dropped at least that below its foothold counts, one sliding
+    down a face; a foot dragged along level ground by a push, or one that
+    never reached its foothold, does not.
     """
     held = np.asarray(desired.support, dtype=bool) & (
         np.linalg.norm(np.asarray(desired.feet) - footholds, axis=1) < HELD_M
@@ -501,6 +507,11 @@ def sliding_leg(
     # off its foothold (the trunk rolling away from it) is no slide.
     moved = np.asarray(measured.feet, dtype=float) - footholds
     moved[:, 2] = np.minimum(moved[:, 2], 0.0)
+    if drop_m > 0.0:
+        down = moved[:, 2] <= -drop_m
+        if on_ground is not None:
+            down &= np.asarray(on_ground, dtype=bool)
+        held = held & down
     off = np.where(held, np.linalg.norm(moved, axis=1), 0.0)
     leg = int(np.argmax(off))
     if off[leg] <= limit:
