@@ -686,9 +686,9 @@ class ReflexConfig:
         trunk is centred again (:func:`~roughwalk.sim.recovery.replant_segments`;
         "hold" where the other three cannot hold the trunk).
     recovery_slide_drop_m:
-        With this [m] > 0, only a foot standing on the ground (within 1 cm)
-        that has dropped at least this below its recovery foothold counts
-        as sliding: one going down a rock's face. 0: any motion along the
+        With this [m] > 0, only a foot that has dropped at least this below
+        its recovery foothold counts as sliding: one going down a rock's
+        face. 0: any motion along the
         ground or down. On flat ground a side push drags feet along the
         ground or leaves a lowered foot short of its foothold, and re-planting
         them there lost pushes main survives (1 N·s right push at 2.0 s: LF

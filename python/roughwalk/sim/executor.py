@@ -775,7 +775,6 @@ class Executor:
             if cfg.recovery_slide_bearing < 3
             else None,
             cfg.recovery_slide_drop_m,
-            near_ground(self.robot, self.terrain_for_recovery, measured.feet),
         )
         if leg is None:
             self._slide_since = None

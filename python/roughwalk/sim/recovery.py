@@ -480,7 +480,6 @@ def sliding_leg(
     others_bearing: int = 3,
     loaded: NDArray[np.bool_] | None = None,
     drop_m: float = 0.0,
-    on_ground: NDArray[np.bool_] | None = None,
 ) -> int | None:
     """A foot sliding off its recovery foothold while the others bear load, else None.
 
@@ -495,10 +494,10 @@ def sliding_leg(
     ``ReflexConfig.recovery_slide_bearing``). ``loaded`` (4,): the feet
     that count as bearing instead (a foot chattering on a rock face bears
     every few ticks, :func:`recently_loaded`). ``drop_m`` [m] > 0: only a
-    foot that stands on the ground (``on_ground`` (4,), :func:`near_ground`)
-    and has dropped at least that below its foothold counts, one sliding
-    down a face; a foot dragged along level ground by a push, or one that
-    never reached its foothold, does not.
+    foot that has dropped at least that below its foothold counts, one
+    sliding down a face; a foot dragged along level ground by a push, or one
+    that never reached its foothold, does not. (Not "on the ground" too: a
+    foot on a 60° face rests a radius above the ground under its centre.)
     """
     held = np.asarray(desired.support, dtype=bool) & (
         np.linalg.norm(np.asarray(desired.feet) - footholds, axis=1) < HELD_M
@@ -508,10 +507,7 @@ def sliding_leg(
     moved = np.asarray(measured.feet, dtype=float) - footholds
     moved[:, 2] = np.minimum(moved[:, 2], 0.0)
     if drop_m > 0.0:
-        down = moved[:, 2] <= -drop_m
-        if on_ground is not None:
-            down &= np.asarray(on_ground, dtype=bool)
-        held = held & down
+        held = held & (moved[:, 2] <= -drop_m)
     off = np.where(held, np.linalg.norm(moved, axis=1), 0.0)
     leg = int(np.argmax(off))
     if off[leg] <= limit:
