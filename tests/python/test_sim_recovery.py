@@ -320,3 +320,16 @@ def test_a_slide_within_the_limit_or_with_too_few_feet_bearing_is_not_caught(sta
     # On main's setting (3 others bearing) the diagonal slide is not watched.
     assert _slide_rf(executor, measured, desired, now, 0.015, [0, 3])[0] is None
     assert _slide_rf(executor, measured, desired, now, 0.015, [0, 2, 3])[0] == 1
+
+
+def test_the_slide_watch_settings_are_checked() -> None:
+    from roughwalk.errors import ConfigError
+
+    for bad in (
+        {"reflex.recovery_slide_bearing": 4},
+        {"reflex.recovery_slide_response": "jump"},
+        {"reflex.recovery_slide_drop_m": -0.001},
+    ):
+        with pytest.raises(ConfigError):
+            override(SimConfig(), bad)
+    assert ReflexConfig().recovery_slide_bearing == 3  # main's watch by default

@@ -197,6 +197,28 @@ def test_a_foot_rising_off_its_foothold_is_no_slide() -> None:
     assert off([0.008, 0.0, -0.008]) == 3  # along and down
 
 
+def test_with_a_drop_only_a_foot_going_down_a_face_is_a_slide() -> None:
+    # 1 N·s right push at 2.0 s on flat ground: LH dragged 3 cm along the
+    # ground; board AE large rocks seed 4: RF slides down its flank.
+    robot = rw.load_robot("littledog")
+    _, _, measured = _standing(robot, rw.load_terrain("flat"))
+    held = _level_pose(robot, measured, "recovery")
+    footholds = measured.feet.copy()
+    forces = np.zeros((4, 3))
+    forces[:, 2] = 8.0
+
+    def off(move: list[float], drop: float) -> int | None:
+        feet = footholds.copy()
+        feet[2] += move
+        now = dataclasses.replace(measured, feet=feet, foot_forces=forces)
+        return sliding_leg(now, held, footholds, 0.01, 1.0, 0, drop_m=drop)
+
+    assert off([-0.03, 0.0, -0.0003], 0.0) == 2  # dragged: a slide without the gate
+    assert off([-0.03, 0.0, -0.0003], 0.003) is None  # not down: no slide with it
+    assert off([-0.01, 0.0, -0.004], 0.003) == 2  # 4 mm down a face
+    assert off([0.0, 0.0, -0.005], 0.003) is None  # down, but within the 1 cm limit
+
+
 # Board AE, bench large rocks seed 5 (``bench_littledog.py --expansions 40000
 # --set reflex.replant_max_slope=0.6981317 --set reflex.recovery_slide_m=0.015``):
 # the recovery after the first reflex (1.37 s) settled at 2.18 s with LH on a
