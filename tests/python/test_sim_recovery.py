@@ -302,12 +302,19 @@ def test_a_scripted_slide_on_a_diagonal_during_a_recovery_is_caught_and_replante
     slid, state, t = _slide_rf(executor, measured, desired, now, 0.015, [0, 3])
     assert slid == 1
     assert t - now >= executor.config.reflex.persist_s - 1e-9  # it must last persist_s
+    # On flat ground there is nowhere better to step: the recovery starts over, RF bearing.
+    restarts = len(executor.log.events_of("recovery"))
+    executor._catch_slide(state, desired, t, slid)
+    assert len(executor.log.events_of("recovery")) == restarts + 1
+    assert executor.log.events_of("recovery")[-1]["feet_down"][1]
+    assert not executor.log.events_of("replant")
+    # With a foothold 1.5 cm on (a face's foot), RF steps there.
+    target = state.feet[1] + [0.0, -0.015, 0.0]
+    executor._slide_target = lambda measured, leg: target  # type: ignore[method-assign]
     executor._catch_slide(state, desired, t, slid)
     replant = executor.log.events_of("replant")[-1]
     assert replant["leg"] == "RF"
-    # On flat ground RF goes down where it slid to, resting on the ground.
-    np.testing.assert_allclose(replant["target"][:2], state.feet[1, :2], atol=1e-9)
-    assert replant["target"][2] == pytest.approx(executor.robot.foot_radius, abs=1e-6)
+    np.testing.assert_allclose(replant["target"], target)
     # The queued motion lifts RF with the other three down, then all four down again.
     support = [s.support[0] for s in executor.buffer.queued]
     assert any(np.array_equal(s, [True, False, True, True]) for s in support)

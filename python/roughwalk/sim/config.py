@@ -674,6 +674,17 @@ class ReflexConfig:
         seed 4's second recovery (2.44 s) stands on LF and RH while RF, bearing
         nothing, slides 5.5 cm down its flank and the trunk rolls over the
         diagonal (35° at 3.06 s); seed 10's first (1.39 s) as RF and RH slide.
+        A foot loaded within the last 50 ms counts as bearing (RH chattered
+        to 0 N every 30 ms there, restarting the watch's persistence).
+        Session 20 (``bench_littledog.py --expansions 40000 --classes
+        large_rocks --seeds 16`` on board AE; ``bench_push_recovery.py
+        --from 1.6 --to 3.2 --direction ±90``): with ``recovery_slide_m``
+        0.01, 2 and "replant", seed 4 reaches the goal (3.43 cm/s) but the
+        right push sweep is 5/9 (main 7/9) and logs seed 1 falls (main 3.69
+        cm/s); with ``recovery_slide_drop_m`` 0.003 too, the pushes are
+        main's (8/9, 7/9) but large rocks 0–15 walk 8/16 at 5.92 cm/s
+        against main's 9/16 at 5.79 (6 gained; 1 and 5 lost; 4 falls) and
+        logs seed 1 still falls. So 3 stays the default.
     recovery_slide_response:
         What a slide caught by ``recovery_slide_m`` does. "lower": the
         recovery starts over, the slid foot put down again like a lifted

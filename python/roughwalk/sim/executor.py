@@ -82,6 +82,8 @@ _SETTLE_BEFORE_S = 0.3
 # still rocks, and the vertical force [N] of a foot that bears load.
 _SETTLE_TICK_S = 0.02
 _LOADED_N = 1.0
+_SLIDE_STEP_MIN_M = 0.005
+"""A slid foot's "replant" target nearer than this [m] (across) restarts the recovery instead."""
 _SLIDE_LOADED_WINDOW_S = 0.05
 """A foot that bore load within this [s] counts as bearing for ``reflex.recovery_slide_bearing``
 below 3: on board AE RH bore 10–25 N with a tick of nothing every 30 ms."""
@@ -631,12 +633,17 @@ class Executor:
         over the other three feet, steps the slid foot onto its re-plant
         target (:func:`~roughwalk.sim.recovery.replant_segments`) and centres
         the trunk again, or starts the recovery over as "hold" where the
-        other three cannot hold the trunk.
+        other three cannot hold the trunk or the target is within
+        :data:`_SLIDE_STEP_MIN_M` of the foot (logs seed 1: feet re-seated
+        in place twice, the walk diverged and fell).
         """
         cfg = self.config.reflex
         if cfg.recovery_slide_response != "replant":
             return self._start_recovery(measured, desired, now, slid=slid)
         target = self._slide_target(measured, slid)
+        if float(np.linalg.norm(target[:2] - measured.feet[slid, :2])) < _SLIDE_STEP_MIN_M:
+            # Nowhere better to step: re-seating it in place only shifts the trunk.
+            return self._start_recovery(measured, desired, now, slid=slid)
         segments = replant_segments(
             self.robot,
             measured,
