@@ -684,7 +684,9 @@ class ReflexConfig:
         cm/s); with ``recovery_slide_drop_m`` 0.003 too, the pushes are
         main's (8/9, 7/9) but large rocks 0–15 walk 8/16 at 5.92 cm/s
         against main's 9/16 at 5.79 (6 gained; 1 and 5 lost; 4 falls) and
-        logs seed 1 still falls. So 3 stays the default.
+        logs seed 1 still falls; restarting the recovery where the slid
+        foot has nowhere 5 mm away to step: 8/16 at 5.67 (15 gained, 1 and
+        3 lost), logs seed 1 falls. So 3 stays the default.
     recovery_slide_response:
         What a slide caught by ``recovery_slide_m`` does. "lower": the
         recovery starts over, the slid foot put down again like a lifted
