@@ -258,3 +258,85 @@ def test_a_still_robot_on_three_loaded_feet_is_settled_only_when_three_are_asked
     assert ReflexConfig().settled_loaded_feet == 3
     with pytest.raises(roughwalk.ConfigError, match="settled_loaded_feet must be 3 or 4"):
         ReflexConfig(settled_loaded_feet=2)
+
+
+def _recovering(standing, **settings: object) -> tuple[Executor, object, object, float]:
+    """An executor in a recovery on four feet on flat ground: (executor, measured, desired, now)."""
+    robot, terrain, measured = standing
+    config = override(SimConfig(), {"reflex.recovery_slide_m": 0.01, **settings})
+    executor = Executor(robot, terrain, CrawlSource(robot, terrain), config=config)
+    forces = np.zeros((4, 3))
+    forces[:, 2] = 8.0
+    loaded = dataclasses.replace(measured, foot_forces=forces)
+    now = float(measured.time)
+    executor._last_loaded[:] = now
+    desired = executor._start_recovery(loaded, executor._standing(loaded), now)
+    return executor, loaded, desired, now
+
+
+def _slide_rf(executor: Executor, measured, desired, now: float, by: float, bearing: list[int]):
+    """Tick the watch 0.05 s with RF ``by`` [m] off its foothold and only ``bearing`` loaded."""
+    feet = measured.feet.copy()
+    feet[1] += [0.0, -by, 0.0]
+    forces = np.zeros((4, 3))
+    forces[bearing, 2] = 10.0
+    slid = None
+    for k in range(6):
+        t = now + 0.01 * k
+        executor._last_loaded[bearing] = t
+        state = dataclasses.replace(measured, feet=feet, foot_forces=forces, time=t)
+        slid = executor._recovery_slide(state, desired, t)
+        if slid is not None:
+            return slid, state, t
+    return slid, None, now
+
+
+def test_a_scripted_slide_on_a_diagonal_during_a_recovery_is_caught_and_replanted(
+    standing,
+) -> None:
+    # RF slides 1.5 cm while only LF and RH bear load (board AE, large rocks seed 4).
+    executor, measured, desired, now = _recovering(
+        standing,
+        **{"reflex.recovery_slide_bearing": 2, "reflex.recovery_slide_response": "replant"},
+    )
+    slid, state, t = _slide_rf(executor, measured, desired, now, 0.015, [0, 3])
+    assert slid == 1
+    assert t - now >= executor.config.reflex.persist_s - 1e-9  # it must last persist_s
+    # On flat ground there is nowhere better to step: the recovery starts over, RF bearing.
+    restarts = len(executor.log.events_of("recovery"))
+    executor._catch_slide(state, desired, t, slid)
+    assert len(executor.log.events_of("recovery")) == restarts + 1
+    assert executor.log.events_of("recovery")[-1]["feet_down"][1]
+    assert not executor.log.events_of("replant")
+    # With a foothold 1.5 cm on (a face's foot), RF steps there.
+    target = state.feet[1] + [0.0, -0.015, 0.0]
+    executor._slide_target = lambda measured, leg: target  # type: ignore[method-assign]
+    executor._catch_slide(state, desired, t, slid)
+    replant = executor.log.events_of("replant")[-1]
+    assert replant["leg"] == "RF"
+    np.testing.assert_allclose(replant["target"], target)
+    # The queued motion lifts RF with the other three down, then all four down again.
+    support = [s.support[0] for s in executor.buffer.queued]
+    assert any(np.array_equal(s, [True, False, True, True]) for s in support)
+    assert np.all(support[-1])
+
+
+def test_a_slide_within_the_limit_or_with_too_few_feet_bearing_is_not_caught(standing) -> None:
+    executor, measured, desired, now = _recovering(standing)
+    assert _slide_rf(executor, measured, desired, now, 0.008, [0, 2, 3])[0] is None
+    # On main's setting (3 others bearing) the diagonal slide is not watched.
+    assert _slide_rf(executor, measured, desired, now, 0.015, [0, 3])[0] is None
+    assert _slide_rf(executor, measured, desired, now, 0.015, [0, 2, 3])[0] == 1
+
+
+def test_the_slide_watch_settings_are_checked() -> None:
+    from roughwalk.errors import ConfigError
+
+    for bad in (
+        {"reflex.recovery_slide_bearing": 4},
+        {"reflex.recovery_slide_response": "jump"},
+        {"reflex.recovery_slide_drop_m": -0.001},
+    ):
+        with pytest.raises(ConfigError):
+            override(SimConfig(), bad)
+    assert ReflexConfig().recovery_slide_bearing == 3  # main's watch by default

@@ -151,6 +151,74 @@ def test_a_held_foot_sliding_off_its_recovery_foothold_is_caught_while_three_bea
     assert sliding_leg(now, lowering, footholds, 0.015, 1.0) is None
 
 
+def test_a_slide_on_a_diagonal_is_caught_when_fewer_others_must_bear() -> None:
+    # Board AE's large-rocks falls: RF slides down a flank while the recovery
+    # stands on the RF–LH diagonal, LF and RH bearing nothing.
+    robot = rw.load_robot("littledog")
+    _, _, measured = _standing(robot, rw.load_terrain("flat"))
+    held = _level_pose(robot, measured, "recovery")
+    footholds = measured.feet.copy()
+    feet = footholds.copy()
+    feet[1] += [0.0, -0.012, -0.012]  # 1.7 cm down and out
+    forces = np.zeros((4, 3))
+    forces[1, 2], forces[2, 2] = 19.0, 2.0
+    now = dataclasses.replace(measured, feet=feet, foot_forces=forces)
+    watch = [sliding_leg(now, held, footholds, 0.015, 1.0, bearing) for bearing in range(4)]
+    assert watch == [1, 1, None, None]  # one other foot (LH) bears load
+    # The count is of the other feet: the slid foot's own load is not one of them.
+    forces[1, 2] = 0.0
+    now = dataclasses.replace(measured, feet=feet, foot_forces=forces)
+    assert sliding_leg(now, held, footholds, 0.015, 1.0, 1) == 1
+    forces[2, 2] = 0.0
+    now = dataclasses.replace(measured, feet=feet, foot_forces=forces)
+    assert sliding_leg(now, held, footholds, 0.015, 1.0, 1) is None
+    assert sliding_leg(now, held, footholds, 0.015, 1.0, 0) == 1
+
+
+def test_a_foot_rising_off_its_foothold_is_no_slide() -> None:
+    # The 1 N·s left push at 2.2 s on flat ground: the roll lifts RH 1 cm off
+    # its foothold; caught as a slide and re-planted, the robot rolled over.
+    robot = rw.load_robot("littledog")
+    _, _, measured = _standing(robot, rw.load_terrain("flat"))
+    held = _level_pose(robot, measured, "recovery")
+    footholds = measured.feet.copy()
+    forces = np.zeros((4, 3))
+    forces[:, 2] = 8.0
+
+    def off(move: list[float]) -> int | None:
+        feet = footholds.copy()
+        feet[3] += move
+        now = dataclasses.replace(measured, feet=feet, foot_forces=forces)
+        return sliding_leg(now, held, footholds, 0.01, 1.0, 0)
+
+    assert off([0.0, 0.0, 0.012]) is None  # up
+    assert off([0.003, 0.0, 0.012]) is None  # up, 3 mm along
+    assert off([0.0, 0.0, -0.012]) == 3  # down a face
+    assert off([0.008, 0.0, -0.008]) == 3  # along and down
+
+
+def test_with_a_drop_only_a_foot_going_down_a_face_is_a_slide() -> None:
+    # 1 N·s right push at 2.0 s on flat ground: LH dragged 3 cm along the
+    # ground; board AE large rocks seed 4: RF slides down its flank.
+    robot = rw.load_robot("littledog")
+    _, _, measured = _standing(robot, rw.load_terrain("flat"))
+    held = _level_pose(robot, measured, "recovery")
+    footholds = measured.feet.copy()
+    forces = np.zeros((4, 3))
+    forces[:, 2] = 8.0
+
+    def off(move: list[float], drop: float) -> int | None:
+        feet = footholds.copy()
+        feet[2] += move
+        now = dataclasses.replace(measured, feet=feet, foot_forces=forces)
+        return sliding_leg(now, held, footholds, 0.01, 1.0, 0, drop_m=drop)
+
+    assert off([-0.03, 0.0, -0.0003], 0.0) == 2  # dragged: a slide without the gate
+    assert off([-0.03, 0.0, -0.0003], 0.003) is None  # not down: no slide with it
+    assert off([-0.01, 0.0, -0.004], 0.003) == 2  # 4 mm down a face
+    assert off([0.0, 0.0, -0.005], 0.003) is None  # down, but within the 1 cm limit
+
+
 # Board AE, bench large rocks seed 5 (``bench_littledog.py --expansions 40000
 # --set reflex.replant_max_slope=0.6981317 --set reflex.recovery_slide_m=0.015``):
 # the recovery after the first reflex (1.37 s) settled at 2.18 s with LH on a

@@ -25,6 +25,10 @@ __all__ = [
 ]
 
 
+RECOVERY_SLIDE_RESPONSES = ("lower", "hold", "replant")
+"""What ``reflex.recovery_slide_m`` does with a foot that slid during a recovery."""
+
+
 def _positive(obj: object, names: tuple[str, ...], prefix: str) -> None:
     for name in names:
         v = getattr(obj, name)
@@ -661,6 +665,47 @@ class ReflexConfig:
         large rocks seed 4's second recovery on main (RF slid 0.17 s in,
         LF and RH still being lowered) and, with ``executor.start_max_slope``
         40°, its first (at the reflex only LF bore load, 1 N).
+    recovery_slide_bearing:
+        How many of the other three feet (0–3) must bear load for
+        ``recovery_slide_m`` to act on a slide. 3: only where they can
+        carry the trunk while the slid foot is put down again (session 17).
+        Fewer watches the recoveries that stand on a diagonal or one side,
+        where the slides that end runs happen: board AE, bench large rocks
+        seed 4's second recovery (2.44 s) stands on LF and RH while RF, bearing
+        nothing, slides 5.5 cm down its flank and the trunk rolls over the
+        diagonal (35° at 3.06 s); seed 10's first (1.39 s) as RF and RH slide.
+        A foot loaded within the last 50 ms counts as bearing (RH chattered
+        to 0 N every 30 ms there, restarting the watch's persistence).
+        Session 20 (``bench_littledog.py --expansions 40000 --classes
+        large_rocks --seeds 16`` on board AE; ``bench_push_recovery.py
+        --from 1.6 --to 3.2 --direction ±90``): with ``recovery_slide_m``
+        0.01, 2 and "replant", seed 4 reaches the goal (3.43 cm/s) but the
+        right push sweep is 5/9 (main 7/9) and logs seed 1 falls (main 3.69
+        cm/s); with ``recovery_slide_drop_m`` 0.003 too, the pushes are
+        main's (8/9, 7/9) but large rocks 0–15 walk 8/16 at 5.92 cm/s
+        against main's 9/16 at 5.79 (6 gained; 1 and 5 lost; 4 falls) and
+        logs seed 1 still falls; restarting the recovery where the slid
+        foot has nowhere 5 mm away to step: 8/16 at 5.67 (15 gained, 1 and
+        3 lost), logs seed 1 falls. So 3 stays the default.
+    recovery_slide_response:
+        What a slide caught by ``recovery_slide_m`` does. "lower": the
+        recovery starts over, the slid foot put down again like a lifted
+        one (unweighted, onto ``replant_max_slope``'s nearest gentle
+        foothold or straight down); "hold": the recovery starts over with the
+        slid foot bearing where it now is, the trunk centred over the
+        measured stance; "replant": the trunk moves over the other three
+        feet, the slid foot steps onto the nearest gentle foothold (or on
+        along its slide onto the first flat ground within 2 cm) and the
+        trunk is centred again (:func:`~roughwalk.sim.recovery.replant_segments`;
+        "hold" where the other three cannot hold the trunk).
+    recovery_slide_drop_m:
+        With this [m] > 0, only a foot that has dropped at least this below
+        its recovery foothold counts as sliding: one going down a rock's
+        face. 0: any motion along the
+        ground or down. On flat ground a side push drags feet along the
+        ground or leaves a lowered foot short of its foothold, and re-planting
+        them there lost pushes main survives (1 N·s right push at 2.0 s: LF
+        1.5 cm up and 2.6 cm off, then LH dragged 3 cm; rolled 35° at 3.25 s).
     max_reflexes:
         Give up (a failed run) after this many reflexes.
     end_at_goal:
@@ -709,6 +754,9 @@ class ReflexConfig:
     replant_certified: bool = True
     recovery_slide_m: float = 0.0
     recovery_slides: int = 2
+    recovery_slide_bearing: int = 3
+    recovery_slide_response: str = "lower"
+    recovery_slide_drop_m: float = 0.0
     max_reflexes: int = 6
     end_at_goal: bool = True
 
@@ -748,12 +796,25 @@ class ReflexConfig:
                 "replant_min_m",
                 "replant_margin_m",
                 "recovery_slide_m",
+                "recovery_slide_drop_m",
             ),
             "reflex",
         )
         if self.settled_loaded_feet not in (3, 4) or isinstance(self.settled_loaded_feet, bool):
             raise ConfigError(
                 f"reflex.settled_loaded_feet must be 3 or 4, got {self.settled_loaded_feet!r}"
+            )
+        if self.recovery_slide_bearing not in (0, 1, 2, 3) or isinstance(
+            self.recovery_slide_bearing, bool
+        ):
+            raise ConfigError(
+                "reflex.recovery_slide_bearing must be 0, 1, 2 or 3, "
+                f"got {self.recovery_slide_bearing!r}"
+            )
+        if self.recovery_slide_response not in RECOVERY_SLIDE_RESPONSES:
+            raise ConfigError(
+                f"unknown reflex.recovery_slide_response {self.recovery_slide_response!r}; "
+                f"known: {', '.join(RECOVERY_SLIDE_RESPONSES)}"
             )
         if not (isinstance(self.recovery_slides, int) and self.recovery_slides >= 0):
             raise ConfigError(

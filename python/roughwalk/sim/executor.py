@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from roughwalk.errors import PlanningError
-from roughwalk.planning.foothold_safety import steep_footholds
+from roughwalk.planning.foothold_safety import resting_centres, steep_footholds
 from roughwalk.robots.canonical_frame import LEG_NAMES
 from roughwalk.sim.config import SimConfig
 from roughwalk.sim.cop_stabilizer import CopStabilizer
@@ -40,9 +40,11 @@ from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
 from roughwalk.sim.outcome import Outcome, OutcomeMonitor
 from roughwalk.sim.recovery import (
+    EDGE_REACH_M,
     blend_segment,
     hold_segment,
     near_ground,
+    off_edge,
     pose_segment,
     recently_loaded,
     recovery_segment,
@@ -80,6 +82,11 @@ _SETTLE_BEFORE_S = 0.3
 # still rocks, and the vertical force [N] of a foot that bears load.
 _SETTLE_TICK_S = 0.02
 _LOADED_N = 1.0
+_SLIDE_STEP_MIN_M = 0.005
+"""A slid foot's "replant" target nearer than this [m] (across) restarts the recovery instead."""
+_SLIDE_LOADED_WINDOW_S = 0.05
+"""A foot that bore load within this [s] counts as bearing for ``reflex.recovery_slide_bearing``
+below 3: on board AE RH bore 10–25 N with a tick of nothing every 30 ms."""
 # How far [m] a foot may have settled from its planned foothold for a re-plan
 # to start from the planned one.
 _NEAR_PLAN_M = 0.025
@@ -362,7 +369,7 @@ class Executor:
             slid = self._recovery_slide(measured, desired, now) if mode == "recovery" else None
             if slid is not None:
                 log.event(now, "recovery_slide", leg=LEG_NAMES[slid], foot=measured.feet[slid])
-                desired = self._start_recovery(measured, desired, now, slid=slid)
+                desired = self._catch_slide(measured, desired, now, slid)
                 steered = desired
             if mode in ("walk", "wait") and monitor.first_motion is not None:
                 trigger = self.reflexes.check(steered, measured)
@@ -581,7 +588,12 @@ class Executor:
             if cfg.standing_bear
             else in_contact
         )
-        if slid is not None:
+        if slid is not None and cfg.recovery_slide_response in ("hold", "replant"):
+            # The slid foot keeps bearing where it now is; the recovery starts
+            # over from the measured stance, the trunk centred over it.
+            bearing[slid] = True
+            in_contact[slid] = True
+        elif slid is not None:
             in_contact[slid] = bearing[slid] = False
             planned[slid] = self._replant_target(measured, slid)
         self._slide_since = None
@@ -610,6 +622,75 @@ class Executor:
         state, _, _ = self.buffer.advance(now)
         assert state is not None
         return state
+
+    def _catch_slide(
+        self, measured: MeasuredState, desired: DesiredState, now: float, slid: int
+    ) -> DesiredState:
+        """The motion after foot ``slid`` slid during a recovery; the desired state to use now.
+
+        ``reflex.recovery_slide_response`` "lower" and "hold" start the
+        recovery over (:meth:`_start_recovery`); "replant" shifts the trunk
+        over the other three feet, steps the slid foot onto its re-plant
+        target (:func:`~roughwalk.sim.recovery.replant_segments`) and centres
+        the trunk again, or starts the recovery over as "hold" where the
+        other three cannot hold the trunk or the target is within
+        :data:`_SLIDE_STEP_MIN_M` of the foot (logs seed 1: feet re-seated
+        in place twice, the walk diverged and fell).
+        """
+        cfg = self.config.reflex
+        if cfg.recovery_slide_response != "replant":
+            return self._start_recovery(measured, desired, now, slid=slid)
+        target = self._slide_target(measured, slid)
+        if float(np.linalg.norm(target[:2] - measured.feet[slid, :2])) < _SLIDE_STEP_MIN_M:
+            # Nowhere better to step: re-seating it in place only shifts the trunk.
+            return self._start_recovery(measured, desired, now, slid=slid)
+        segments = replant_segments(
+            self.robot,
+            measured,
+            slid,
+            target,
+            cfg.replant_s,
+            cfg.settle_s,
+            now,
+            cfg.replant_margin_m,
+        )
+        if segments is None:
+            return self._start_recovery(measured, desired, now, slid=slid)
+        self._slide_since = None
+        self._settle_deadline = None
+        self.buffer.clear()
+        self.integrator.reset()
+        self.stabilizer.reset()
+        self.touchdown.reset()
+        self.reflexes.reset()
+        for segment in segments:
+            self.buffer.append(segment)
+        footholds = np.array(measured.feet, dtype=float)
+        footholds[slid] = target
+        self._recovery_footholds = footholds
+        self.log.event(now, "replant", leg=LEG_NAMES[slid], foot=measured.feet[slid], target=target)
+        state, _, _ = self.buffer.advance(now)
+        assert state is not None
+        return state
+
+    def _slide_target(self, measured: MeasuredState, leg: int) -> np.ndarray:
+        """Where a foot that slid steps with ``recovery_slide_response`` "replant".
+
+        The nearest gentle foothold (:meth:`_replant_target`, with
+        ``reflex.replant_max_slope``); else on along the slide, off the face
+        onto the first flat ground within
+        :data:`~roughwalk.sim.recovery.EDGE_REACH_M`
+        (:func:`~roughwalk.sim.recovery.off_edge`), resting on it.
+        """
+        foot = np.array(measured.feet[leg], dtype=float)
+        target = self._replant_target(measured, leg)
+        if np.linalg.norm(target - foot) > 1e-9:
+            return target
+        way = foot - self._recovery_footholds[leg]
+        ahead = foot + way * (EDGE_REACH_M / max(float(np.linalg.norm(way[:2])), 1e-9))
+        r = self.robot.foot_radius
+        moved = off_edge(self.terrain_for_recovery, foot, ahead, r, EDGE_REACH_M)
+        return resting_centres(self.terrain_for_recovery, moved[None, :2], r)[0]
 
     def _replant_target(self, measured: MeasuredState, leg: int) -> np.ndarray:
         """Where a foot that slid goes down again: the nearest gentle foothold, or where it is.
@@ -695,6 +776,12 @@ class Executor:
             self._recovery_footholds,
             cfg.recovery_slide_m,
             _LOADED_N,
+            cfg.recovery_slide_bearing,
+            # Chattering feet (a rock face) bear every few ticks.
+            recently_loaded(self._last_loaded, now, _SLIDE_LOADED_WINDOW_S)
+            if cfg.recovery_slide_bearing < 3
+            else None,
+            cfg.recovery_slide_drop_m,
         )
         if leg is None:
             self._slide_since = None

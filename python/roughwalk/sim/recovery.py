@@ -477,23 +477,44 @@ def sliding_leg(
     footholds: NDArray[np.float64],
     limit: float,
     loaded_n: float,
+    others_bearing: int = 3,
+    loaded: NDArray[np.bool_] | None = None,
+    drop_m: float = 0.0,
 ) -> int | None:
-    """A foot sliding off its recovery foothold while the other three bear load, else None.
+    """A foot sliding off its recovery foothold while the others bear load, else None.
 
     Watched: the feet the recovery holds on their ``footholds`` (4, 3) [m]
     (desired supporting, within :data:`HELD_M` of them). The one farthest
-    beyond ``limit`` [m] counts if the other three each bear more than
-    ``loaded_n`` [N]: they can carry the trunk while it is put down again.
+    beyond ``limit`` [m] along the ground or down (a foot rising off its
+    foothold does not count: on flat ground a side push's roll lifts one)
+    counts if at least ``others_bearing`` (0–3) of the
+    other three each bear more than ``loaded_n`` [N]: with 3 they can carry
+    the trunk while it is put down again; with fewer the slide is caught
+    where the recovery stands on a diagonal or on one side (see
+    ``ReflexConfig.recovery_slide_bearing``). ``loaded`` (4,): the feet
+    that count as bearing instead (a foot chattering on a rock face bears
+    every few ticks, :func:`recently_loaded`). ``drop_m`` [m] > 0: only a
+    foot that has dropped at least that below its foothold counts, one
+    sliding down a face; a foot dragged along level ground by a push, or one
+    that never reached its foothold, does not. (Not "on the ground" too: a
+    foot on a 60° face rests a radius above the ground under its centre.)
     """
     held = np.asarray(desired.support, dtype=bool) & (
         np.linalg.norm(np.asarray(desired.feet) - footholds, axis=1) < HELD_M
     )
-    off = np.where(held, np.linalg.norm(measured.feet - footholds, axis=1), 0.0)
+    # A slide moves the foot along the ground or down a face; a foot rising
+    # off its foothold (the trunk rolling away from it) is no slide.
+    moved = np.asarray(measured.feet, dtype=float) - footholds
+    moved[:, 2] = np.minimum(moved[:, 2], 0.0)
+    if drop_m > 0.0:
+        held = held & (moved[:, 2] <= -drop_m)
+    off = np.where(held, np.linalg.norm(moved, axis=1), 0.0)
     leg = int(np.argmax(off))
     if off[leg] <= limit:
         return None
-    others = np.delete(np.asarray(measured.foot_forces)[:, 2], leg)
-    return leg if bool(np.all(others > loaded_n)) else None
+    bears = np.asarray(measured.foot_forces)[:, 2] > loaded_n if loaded is None else loaded
+    others = np.delete(np.asarray(bears, dtype=bool), leg)
+    return leg if int(np.sum(others)) >= others_bearing else None
 
 
 REPLANT_LIFT_M = 0.02
