@@ -255,9 +255,9 @@ def figure_6(args: argparse.Namespace, spec: ProblemSpec) -> dict[str, Any]:
     # (None when the heuristic solved no held-out task feasibly: double pallet.)
     heuristic_ok = feasible_mask(runs["Heuristic"])
     fence = cost_threshold(runs["Heuristic"]["cost"][heuristic_ok]) if heuristic_ok.any() else None
-    g_max, cost_model = (
-        list(fences.values())[-1] if fences else (math.inf if fence is None else fence, None)
-    )
+    g_max = list(fences.values())[-1][0] if fences else (math.inf if fence is None else fence)
+    # The last model's per-task cost model that has one (as before several models were judged).
+    cost_model = next((c for _, c in reversed(list(fences.values())) if c is not None), None)
     fences.setdefault("Heuristic", (g_max, cost_model))
     costs = np.stack([np.where(feasible_mask(v), v["cost"], np.inf) for v in runs.values()])
     best = costs.min(axis=0)

@@ -362,11 +362,16 @@ def main(argv: list[str] | None = None) -> int:
         ]
         args.set = [*budget, *args.set]  # the user's --set still wins
         args.plan_time = BUDGET_TIME_LIMIT_S
-    on_boards = [k for k in args.classes.split(",") if k in BOARDS]
-    if on_boards and not SHARED.is_dir():
+    # Classes whose board is missing (course() then walks a generated course).
+    missing = [
+        k
+        for k in (c.strip() for c in args.classes.split(","))
+        if k in BOARDS and not (SHARED / f"terrain{BOARDS[k]}.mat").is_file()
+    ]
+    if missing:
         print(
             f"note: the LittleDog boards are not at {SHARED} (set ROUGHWALK_SHARED to the "
-            f"shared data folder): {', '.join(on_boards)} walk generated courses instead",
+            f"shared data folder): {', '.join(missing)} walk generated courses instead",
             file=sys.stderr,
         )
     try:

@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -57,7 +58,7 @@ from roughwalk.cli.common import machine_description, write_json
 from roughwalk.planning import FootstepConfig, FootstepPlanner
 
 HERE = Path(__file__).resolve().parent
-SHARED = HERE.parent.parent / "shared"
+SHARED = Path(os.environ.get("ROUGHWALK_SHARED") or HERE.parent.parent / "shared")
 GOLDEN = HERE.parent / "tests" / "data" / "footstep_golden_sideways.json"
 BOARDS = {
     "AE": ("Large rocks", "terrainAE"),

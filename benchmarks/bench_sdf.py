@@ -33,7 +33,7 @@ from roughwalk.terrain import SignedDistanceField, Terrain, load_terrain
 from roughwalk.terrain.sdf import available_edt_backends
 
 HERE = Path(__file__).resolve().parent
-SHARED = HERE.parent.parent / "shared"
+SHARED = Path(os.environ.get("ROUGHWALK_SHARED") or HERE.parent.parent / "shared")
 DEFAULT_BOARDS = ("terrainA", "terrainAC", "terrainAE")
 
 

@@ -36,7 +36,8 @@ from roughwalk.cli.common import machine_description, result_envelope, write_jso
 from roughwalk.trajectories import FootstepTrajectoryGenerator, straight_crawl_plan
 
 RESULTS = Path(__file__).resolve().parent / "results" / "trajectory.json"
-SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "terrains" / "littledog"
+_BESIDE = Path(__file__).resolve().parents[1].parent / "shared"
+SHARED = Path(os.environ.get("ROUGHWALK_SHARED") or _BESIDE) / "terrains" / "littledog"
 BOARDS = ("A", "AC", "AD", "AE", "C", "Y")
 TARGET_MS = 50.0
 

@@ -280,6 +280,8 @@ def _slide_rf(executor: Executor, measured, desired, now: float, by: float, bear
     feet[1] += [0.0, -by, 0.0]
     forces = np.zeros((4, 3))
     forces[bearing, 2] = 10.0
+    # The feet that bear nothing have not borne load lately either (the 50 ms window).
+    executor._last_loaded[[i for i in range(4) if i not in bearing]] = -np.inf
     slid = None
     for k in range(6):
         t = now + 0.01 * k
@@ -299,6 +301,8 @@ def test_a_scripted_slide_on_a_diagonal_during_a_recovery_is_caught_and_replante
         standing,
         **{"reflex.recovery_slide_bearing": 2, "reflex.recovery_slide_response": "replant"},
     )
+    # LF alone bearing is not a diagonal: not watched.
+    assert _slide_rf(executor, measured, desired, now, 0.015, [0])[0] is None
     slid, state, t = _slide_rf(executor, measured, desired, now, 0.015, [0, 3])
     assert slid == 1
     assert t - now >= executor.config.reflex.persist_s - 1e-9  # it must last persist_s

@@ -195,6 +195,11 @@ def test_a_foot_rising_off_its_foothold_is_no_slide() -> None:
     assert off([0.003, 0.0, 0.012]) is None  # up, 3 mm along
     assert off([0.0, 0.0, -0.012]) == 3  # down a face
     assert off([0.008, 0.0, -0.008]) == 3  # along and down
+    # Session 17's watch (3 others bearing, no drop gate) is kept as measured: rising counts.
+    feet = footholds.copy()
+    feet[3] += [0.0, 0.0, 0.012]
+    risen = dataclasses.replace(measured, feet=feet, foot_forces=forces)
+    assert sliding_leg(risen, held, footholds, 0.01, 1.0, 3) == 3
 
 
 def test_with_a_drop_only_a_foot_going_down_a_face_is_a_slide() -> None:

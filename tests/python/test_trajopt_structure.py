@@ -398,3 +398,13 @@ def test_dropped_picked_samples_lend_no_jacobian_to_later_expressions() -> None:
         u = ca.vertcat(*[vel for _, vel, _ in spline.points(times)])
         f = ca.Function("f", [z], [points_jacobian(u, z, spline.picked) - ca.jacobian(u, z)])
         assert np.max(np.abs(np.asarray(f(values)))) < 1e-12
+
+
+def test_an_admitted_phase_shorter_than_the_margin_keeps_a_positive_lower_bound() -> None:
+    # A 6 ms phase admitted below TOWR's 0.2 s: its bound comes down to half
+    # of itself, never to 0 or below (a zero-length phase has no polynomial).
+    nominal = [0.006, 0.5, 0.5]
+    admitted = PhaseDurations(0, nominal, (0.2, 1.0), optimize=True, admit_nominal=True)
+    assert admitted.lower[0] == pytest.approx(0.003)
+    assert admitted.lower[1] == pytest.approx(0.2)
+    assert np.all(admitted.lower > 0.0) and np.all(admitted.lower < nominal[:-1])

@@ -680,7 +680,8 @@ class Executor:
         ``reflex.replant_max_slope``); else on along the slide, off the face
         onto the first flat ground within
         :data:`~roughwalk.sim.recovery.EDGE_REACH_M`
-        (:func:`~roughwalk.sim.recovery.off_edge`), resting on it.
+        (:func:`~roughwalk.sim.recovery.off_edge`), resting on it, if the
+        stance there has a pose certificate (as :meth:`_replant_target`'s).
         """
         foot = np.array(measured.feet[leg], dtype=float)
         target = self._replant_target(measured, leg)
@@ -690,7 +691,10 @@ class Executor:
         ahead = foot + way * (EDGE_REACH_M / max(float(np.linalg.norm(way[:2])), 1e-9))
         r = self.robot.foot_radius
         moved = off_edge(self.terrain_for_recovery, foot, ahead, r, EDGE_REACH_M)
-        return resting_centres(self.terrain_for_recovery, moved[None, :2], r)[0]
+        target = resting_centres(self.terrain_for_recovery, moved[None, :2], r)[0]
+        # As every re-plant (``reflex.replant_certified``): only where the stance
+        # has a pose certificate; else where it is, which starts the recovery over.
+        return target if self._replant_certified(measured, leg, target) else foot
 
     def _replant_target(self, measured: MeasuredState, leg: int) -> np.ndarray:
         """Where a foot that slid goes down again: the nearest gentle foothold, or where it is.

@@ -485,9 +485,10 @@ def sliding_leg(
 
     Watched: the feet the recovery holds on their ``footholds`` (4, 3) [m]
     (desired supporting, within :data:`HELD_M` of them). The one farthest
-    beyond ``limit`` [m] along the ground or down (a foot rising off its
-    foothold does not count: on flat ground a side push's roll lifts one)
-    counts if at least ``others_bearing`` (0–3) of the
+    beyond ``limit`` [m] counts (with ``others_bearing`` below 3 or
+    ``drop_m`` > 0 only along the ground or down: a foot rising off its
+    foothold does not count, since on flat ground a side push's roll lifts
+    one) if at least ``others_bearing`` (0–3) of the
     other three each bear more than ``loaded_n`` [N]: with 3 they can carry
     the trunk while it is put down again; with fewer the slide is caught
     where the recovery stands on a diagonal or on one side (see
@@ -503,9 +504,12 @@ def sliding_leg(
         np.linalg.norm(np.asarray(desired.feet) - footholds, axis=1) < HELD_M
     )
     # A slide moves the foot along the ground or down a face; a foot rising
-    # off its foothold (the trunk rolling away from it) is no slide.
+    # off its foothold (the trunk rolling away from it) is no slide. Only in
+    # session 20's modes (fewer bearing feet, or a drop gate): the original
+    # watch (3 bearing, no gate) stays as measured in session 17.
     moved = np.asarray(measured.feet, dtype=float) - footholds
-    moved[:, 2] = np.minimum(moved[:, 2], 0.0)
+    if others_bearing < 3 or drop_m > 0.0:
+        moved[:, 2] = np.minimum(moved[:, 2], 0.0)
     if drop_m > 0.0:
         held = held & (moved[:, 2] <= -drop_m)
     off = np.where(held, np.linalg.norm(moved, axis=1), 0.0)

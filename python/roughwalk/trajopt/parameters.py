@@ -520,8 +520,9 @@ class TrajoptConfig:
         (min, max) [s] of an optimised phase (TOWR's 0.2–1.0 s).
     phase_bounds_admit_gait:
         Widen each optimised phase's bounds to admit its own duration in the
-        gait: [min(min, d − 0.01 s), max(max, d + 0.01 s)] with d that
-        phase's gait duration (others keep ``phase_duration_bounds``; the
+        gait: [min(min, max(d − 0.01 s, d / 2)), min(max(max, d + 0.01 s), T)]
+        with d that phase's gait duration and T the total (others keep
+        ``phase_duration_bounds``; the
         0.01 s keeps IPOPT's bound push from moving a phase that would sit
         on its bound). The 16-step walk in 5.5 s
         and the double pallet's 20 steps in 6.875 s give the front-right

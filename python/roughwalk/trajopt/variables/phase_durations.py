@@ -77,7 +77,8 @@ class PhaseDurations(VariableSet):
             self.upper[:] = hi
             if admit_nominal and n > 1:
                 own = np.asarray(self.nominal[:-1])
-                self.lower[:] = np.minimum(lo, own - ADMIT_MARGIN)
+                # Never down to 0: a phase of the gait shorter than the margin keeps half of itself.
+                self.lower[:] = np.minimum(lo, np.maximum(own - ADMIT_MARGIN, 0.5 * own))
                 self.upper[:] = np.minimum(np.maximum(hi, own + ADMIT_MARGIN), self.total)
                 lo, hi = float(self.lower.min()), float(self.upper.max())
         self.bounds = (float(lo), float(hi))
