@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -175,9 +176,9 @@ def test_a_slide_on_a_diagonal_is_caught_when_fewer_others_must_bear() -> None:
     assert sliding_leg(now, held, footholds, 0.015, 1.0, 0) == 1
 
 
-def test_a_foot_rising_off_its_foothold_is_no_slide() -> None:
-    # The 1 N·s left push at 2.2 s on flat ground: the roll lifts RH 1 cm off
-    # its foothold; caught as a slide and re-planted, the robot rolled over.
+def _held_on_flat() -> Callable[..., int | None]:
+    """``sliding_leg`` of LittleDog held in a recovery on flat ground, four feet
+    bearing 8 N, with one foot moved: ``watch(leg, move, others_bearing, drop_m)``."""
     robot = rw.load_robot("littledog")
     _, _, measured = _standing(robot, rw.load_terrain("flat"))
     held = _level_pose(robot, measured, "recovery")
@@ -185,43 +186,35 @@ def test_a_foot_rising_off_its_foothold_is_no_slide() -> None:
     forces = np.zeros((4, 3))
     forces[:, 2] = 8.0
 
-    def off(move: list[float]) -> int | None:
+    def watch(leg: int, move: list[float], others: int = 0, drop: float = 0.0) -> int | None:
         feet = footholds.copy()
-        feet[3] += move
+        feet[leg] += move
         now = dataclasses.replace(measured, feet=feet, foot_forces=forces)
-        return sliding_leg(now, held, footholds, 0.01, 1.0, 0)
+        return sliding_leg(now, held, footholds, 0.01, 1.0, others, drop_m=drop)
 
-    assert off([0.0, 0.0, 0.012]) is None  # up
-    assert off([0.003, 0.0, 0.012]) is None  # up, 3 mm along
-    assert off([0.0, 0.0, -0.012]) == 3  # down a face
-    assert off([0.008, 0.0, -0.008]) == 3  # along and down
+    return watch
+
+
+def test_a_foot_rising_off_its_foothold_is_no_slide() -> None:
+    # The 1 N·s left push at 2.2 s on flat ground: the roll lifts RH 1 cm off
+    # its foothold; caught as a slide and re-planted, the robot rolled over.
+    watch = _held_on_flat()
+    assert watch(3, [0.0, 0.0, 0.012]) is None  # up
+    assert watch(3, [0.003, 0.0, 0.012]) is None  # up, 3 mm along
+    assert watch(3, [0.0, 0.0, -0.012]) == 3  # down a face
+    assert watch(3, [0.008, 0.0, -0.008]) == 3  # along and down
     # Session 17's watch (3 others bearing, no drop gate) is kept as measured: rising counts.
-    feet = footholds.copy()
-    feet[3] += [0.0, 0.0, 0.012]
-    risen = dataclasses.replace(measured, feet=feet, foot_forces=forces)
-    assert sliding_leg(risen, held, footholds, 0.01, 1.0, 3) == 3
+    assert watch(3, [0.0, 0.0, 0.012], others=3) == 3
 
 
 def test_with_a_drop_only_a_foot_going_down_a_face_is_a_slide() -> None:
     # 1 N·s right push at 2.0 s on flat ground: LH dragged 3 cm along the
     # ground; board AE large rocks seed 4: RF slides down its flank.
-    robot = rw.load_robot("littledog")
-    _, _, measured = _standing(robot, rw.load_terrain("flat"))
-    held = _level_pose(robot, measured, "recovery")
-    footholds = measured.feet.copy()
-    forces = np.zeros((4, 3))
-    forces[:, 2] = 8.0
-
-    def off(move: list[float], drop: float) -> int | None:
-        feet = footholds.copy()
-        feet[2] += move
-        now = dataclasses.replace(measured, feet=feet, foot_forces=forces)
-        return sliding_leg(now, held, footholds, 0.01, 1.0, 0, drop_m=drop)
-
-    assert off([-0.03, 0.0, -0.0003], 0.0) == 2  # dragged: a slide without the gate
-    assert off([-0.03, 0.0, -0.0003], 0.003) is None  # not down: no slide with it
-    assert off([-0.01, 0.0, -0.004], 0.003) == 2  # 4 mm down a face
-    assert off([0.0, 0.0, -0.005], 0.003) is None  # down, but within the 1 cm limit
+    watch = _held_on_flat()
+    assert watch(2, [-0.03, 0.0, -0.0003]) == 2  # dragged: a slide without the gate
+    assert watch(2, [-0.03, 0.0, -0.0003], drop=0.003) is None  # not down: no slide with it
+    assert watch(2, [-0.01, 0.0, -0.004], drop=0.003) == 2  # 4 mm down a face
+    assert watch(2, [0.0, 0.0, -0.005], drop=0.003) is None  # down, but within the 1 cm limit
 
 
 # Board AE, bench large rocks seed 5 (``bench_littledog.py --expansions 40000

@@ -644,16 +644,7 @@ class Executor:
         if float(np.linalg.norm(target[:2] - measured.feet[slid, :2])) < _SLIDE_STEP_MIN_M:
             # Nowhere better to step: re-seating it in place only shifts the trunk.
             return self._start_recovery(measured, desired, now, slid=slid)
-        segments = replant_segments(
-            self.robot,
-            measured,
-            slid,
-            target,
-            cfg.replant_s,
-            cfg.settle_s,
-            now,
-            cfg.replant_margin_m,
-        )
+        segments = self._replant_motion(measured, slid, target, now)
         if segments is None:
             return self._start_recovery(measured, desired, now, slid=slid)
         self._slide_since = None
@@ -672,6 +663,22 @@ class Executor:
         state, _, _ = self.buffer.advance(now)
         assert state is not None
         return state
+
+    def _replant_motion(
+        self, measured: MeasuredState, leg: int, target: np.ndarray, now: float
+    ) -> list[Segment] | None:
+        """:func:`~roughwalk.sim.recovery.replant_segments` with ``reflex``'s timing and margin."""
+        cfg = self.config.reflex
+        return replant_segments(
+            self.robot,
+            measured,
+            leg,
+            target,
+            cfg.replant_s,
+            cfg.settle_s,
+            now,
+            cfg.replant_margin_m,
+        )
 
     def _slide_target(self, measured: MeasuredState, leg: int) -> np.ndarray:
         """Where a foot that slid steps with ``recovery_slide_response`` "replant".
@@ -809,16 +816,7 @@ class Executor:
             if leg in self._replanted:
                 continue
             self._replanted.add(leg)
-            segments = replant_segments(
-                self.robot,
-                measured,
-                leg,
-                target,
-                cfg.replant_s,
-                cfg.settle_s,
-                now,
-                cfg.replant_margin_m,
-            )
+            segments = self._replant_motion(measured, leg, target, now)
             if segments is None:
                 continue
             if not self._replant_certified(measured, leg, target):
