@@ -598,11 +598,7 @@ class Executor:
             planned[slid] = self._replant_target(measured, slid)
         self._slide_since = None
         self._plan = None
-        self.buffer.clear()
-        self.integrator.reset()
-        self.stabilizer.reset()
-        self.touchdown.reset()
-        self.reflexes.reset()
+        self._drop_motion()
         segments, footholds = recovery_segment(
             self.robot,
             self.terrain_for_recovery,
@@ -649,11 +645,7 @@ class Executor:
             return self._start_recovery(measured, desired, now, slid=slid)
         self._slide_since = None
         self._settle_deadline = None
-        self.buffer.clear()
-        self.integrator.reset()
-        self.stabilizer.reset()
-        self.touchdown.reset()
-        self.reflexes.reset()
+        self._drop_motion()
         for segment in segments:
             self.buffer.append(segment)
         footholds = np.array(measured.feet, dtype=float)
@@ -663,6 +655,14 @@ class Executor:
         state, _, _ = self.buffer.advance(now)
         assert state is not None
         return state
+
+    def _drop_motion(self) -> None:
+        """Forget the queued motion and every per-leg and reflex state built on it."""
+        self.buffer.clear()
+        self.integrator.reset()
+        self.stabilizer.reset()
+        self.touchdown.reset()
+        self.reflexes.reset()
 
     def _replant_motion(
         self, measured: MeasuredState, leg: int, target: np.ndarray, now: float
