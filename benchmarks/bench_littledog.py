@@ -77,13 +77,14 @@ BOARDS = {"large_rocks": "AE", "round_rocks": "AC", "sloped_rocks": "Y", "logs":
 CLASSES = ("large_rocks", "round_rocks", "sloped_rocks", "logs", "gap", "barrier", "steps")
 TARGET_CM_S = 7.2
 # Shares of a run's clock (roughwalk.sim.time_breakdown) and their columns' heads.
-SHARES = ("shift", "swing", "stretch", "settle", "wait", "reflex", "replan")
+SHARES = ("shift", "swing", "stretch", "settle", "wait", "gate", "reflex", "replan")
 SHARE_HEADS = {
     "shift": "shift%",
     "swing": "swing%",
     "stretch": "strch%",
     "settle": "settl%",
     "wait": "wait%",
+    "gate": "gate%",
     "reflex": "reflx%",
     "replan": "replan%",
 }

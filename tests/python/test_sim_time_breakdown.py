@@ -50,7 +50,7 @@ def test_each_share_of_a_scripted_run_lands_in_its_place(tmp_path: Path) -> None
     # Step 1: shift 0.1 s, swing 0.4 s of which 0.1 s is stretch (fitted 0.3 s);
     # a 0.2 s wait; step 2 unstretched; a reflex's 0.5 s recovery, 0.3 s of
     # re-planning and a 0.2 s blend; the new plan's step 1, its shift
-    # stretched from 0.06 to 0.1 s.
+    # stretched from 0.06 to 0.1 s, held 0.05 s at its lift-off (the lift gate).
     pieces = [
         ("walk", 0, 1, 0.1),
         ("walk", 1, 1, 0.4),
@@ -61,6 +61,7 @@ def test_each_share_of_a_scripted_run_lands_in_its_place(tmp_path: Path) -> None
         ("replan", OTHER_PHASE, 0, 0.3),
         ("walk", OTHER_PHASE, 0, 0.2),
         ("walk", 0, 1, 0.1),
+        ("gate", 0, 1, 0.05),
         ("walk", 1, 1, 0.3),
     ]
     events = [
@@ -69,22 +70,26 @@ def test_each_share_of_a_scripted_run_lands_in_its_place(tmp_path: Path) -> None
         {"time": 2.1, "kind": "step", "step": 1, "fitted_s": [0.06, 0.3], "stretch_s": [0.04, 0]},
     ]
     log = written_log(tmp_path, pieces, events)
-    split = time_breakdown(log, 0.0, 2.5)
+    split = time_breakdown(log, 0.0, 2.55)
     expected = {
         "shift": 0.1 + 0.1 + 0.06,
         "swing": 0.3 + 0.3 + 0.3,
         "stretch": 0.1 + 0.04,
         "settle": 0.0,
         "wait": 0.2,
+        "gate": 0.05,
         "reflex": 0.5,
         "replan": 0.3 + 0.2,
     }
     for name, seconds in expected.items():
         assert split.shares_s[name] == pytest.approx(seconds, abs=1e-9), name
-    assert split.total_s == pytest.approx(2.5, abs=1e-9)
+    assert split.total_s == pytest.approx(2.55, abs=1e-9)
     first, second, third = split.footsteps
     assert first.stretch_s == pytest.approx(0.1) and first.wait_s == pytest.approx(0.2)
     assert second.stretch_s == 0.0 and third.stretch_s == pytest.approx(0.04)
+    # The hold is the footstep's own, not its shift's stretch.
+    assert third.gate_s == pytest.approx(0.05) and third.shift_s == pytest.approx(0.06)
+    assert third.duration_s == pytest.approx(0.1 + 0.05 + 0.3)
     summary = split.summary()
     assert sum(summary[f"{k}_fraction"] for k in expected) == pytest.approx(1.0)
 

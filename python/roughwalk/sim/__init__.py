@@ -4,8 +4,8 @@ Start with :func:`run` (a robot, a terrain, a start and a goal in; a
 :class:`RunResult` out). The pieces are usable alone: :class:`World` (robot
 + terrain in one MuJoCo model), :class:`Runner` (servo commands at the
 control rate), :class:`TrajectoryBuffer`, :class:`JointController`,
-:class:`LegIntegrator`, :class:`CopStabilizer`, :class:`ReflexMonitor`, :class:`Executor`,
-:class:`OutcomeMonitor`, :class:`RunLog` and the disturbances.
+:class:`LegIntegrator`, :class:`LiftGate`, :class:`CopStabilizer`, :class:`ReflexMonitor`,
+:class:`Executor`, :class:`OutcomeMonitor`, :class:`RunLog` and the disturbances.
 """
 
 from roughwalk.sim.config import (
@@ -13,6 +13,7 @@ from roughwalk.sim.config import (
     ControllerConfig,
     ExecutorConfig,
     IntegratorConfig,
+    LiftGateConfig,
     OutcomeConfig,
     ReflexConfig,
     SimConfig,
@@ -33,6 +34,7 @@ from roughwalk.sim.footstep_source import (
 )
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
+from roughwalk.sim.lift_gate import LiftGate
 from roughwalk.sim.measured_state import MeasuredState, measure
 from roughwalk.sim.outcome import Outcome, OutcomeMonitor
 from roughwalk.sim.reflexes import ReflexMonitor, ReflexTrigger
@@ -53,6 +55,7 @@ __all__ = [
     "IntegratorConfig",
     "StabilizerConfig",
     "TouchdownConfig",
+    "LiftGateConfig",
     "ReflexConfig",
     "OutcomeConfig",
     "ExecutorConfig",
@@ -66,6 +69,7 @@ __all__ = [
     "DesiredState",
     "JointController",
     "LegIntegrator",
+    "LiftGate",
     "CopStabilizer",
     "centre_of_pressure",
     "ReflexMonitor",

@@ -18,6 +18,7 @@ __all__ = [
     "ControllerConfig",
     "IntegratorConfig",
     "TouchdownConfig",
+    "LiftGateConfig",
     "StabilizerConfig",
     "ReflexConfig",
     "OutcomeConfig",
@@ -279,6 +280,47 @@ class TouchdownConfig:
             "touchdown",
         )
         _positive(self, ("release_s",), "touchdown")
+
+
+@dataclass(frozen=True)
+class LiftGateConfig:
+    """Hold a footstep at lift-off until the feet that stay down bear (the ``LiftGate``).
+
+    The plan lifts a foot on time; on a rock the foot that landed last can
+    still hang a few millimetres over its foothold (the touchdown search is
+    lowering it) or slide down a flank, and the three feet the swing stands
+    on are then two. On board AE (large rocks, seed 4, the walk's
+    defaults) LH bore nothing from its touchdown at 0.70 s until 0.85 s,
+    LF lifted at 0.82 s with the planned CoM 1.2 cm inside the RF–LH–RH
+    triangle, and the robot tipped over the RF–LH diagonal: the foot-force
+    reflex fired at 0.93 s and the run rolled over. The gate holds the
+    plan (its clock stops, every joint target still) at the tick before
+    a foot lifts while a foot that stays down bears less than
+    ``least_n`` or ``fraction`` of the load the swing plans on it,
+    whichever is smaller; for at most ``max_hold_s``, then the step goes
+    on. The hold counts against the run's speed (the ``gate`` share of
+    the time breakdown).
+
+    Attributes
+    ----------
+    enabled:
+        Gate lift-offs at all (off by default).
+    least_n:
+        [N] a staying foot bearing this much counts as bearing.
+    fraction:
+        Or this share of the vertical load the swing's first sample plans
+        on it, if that is less (a foot planned light).
+    max_hold_s:
+        The longest hold [s] of one lift-off.
+    """
+
+    enabled: bool = False
+    least_n: float = 2.0
+    fraction: float = 0.5
+    max_hold_s: float = 0.3
+
+    def __post_init__(self) -> None:
+        _nonnegative(self, ("least_n", "fraction", "max_hold_s"), "lift_gate")
 
 
 @dataclass(frozen=True)
@@ -979,6 +1021,7 @@ class SimConfig:
     controller: ControllerConfig = field(default_factory=ControllerConfig)
     integrator: IntegratorConfig = field(default_factory=IntegratorConfig)
     touchdown: TouchdownConfig = field(default_factory=TouchdownConfig)
+    lift_gate: LiftGateConfig = field(default_factory=LiftGateConfig)
     stabilizer: StabilizerConfig = field(default_factory=StabilizerConfig)
     reflex: ReflexConfig = field(default_factory=ReflexConfig)
     outcome: OutcomeConfig = field(default_factory=OutcomeConfig)

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -38,6 +38,7 @@ from roughwalk.sim.foothold_snap import replant_targets
 from roughwalk.sim.footstep_source import CRAWL_ORDER, FootstepSource, PlanAttempt, PlanStart
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
+from roughwalk.sim.lift_gate import LiftGate
 from roughwalk.sim.outcome import Outcome, OutcomeMonitor
 from roughwalk.sim.recovery import (
     EDGE_REACH_M,
@@ -185,6 +186,7 @@ class Executor:
         self.integrator = LegIntegrator(robot, self.config.integrator, self.world.control_dt)
         self.stabilizer = CopStabilizer(self.config.stabilizer, self.world.control_dt)
         self.touchdown = TouchdownAdapter(self.config.touchdown, self.world.control_dt)
+        self.lift_gate = LiftGate(self.config.lift_gate, self.world.control_dt)
         self.reflexes = ReflexMonitor(self.config.reflex)
         self.generator = FootstepTrajectoryGenerator(
             robot, self.planner_terrain, sdf=sdf, config=trajectory_config
@@ -358,6 +360,25 @@ class Executor:
                 mode = "walk"
             if mode in ("walk", "wait"):
                 mode = "wait" if waiting else "walk"
+            logged = mode
+            if (
+                mode == "walk"
+                and current is not None
+                and desired is not None
+                and self.lift_gate.hold(current, now - self.buffer.started_at, desired, measured)
+            ):
+                # A foot that stays down does not bear yet: the plan's clock stops
+                # at the lift-off, every joint target held still.
+                self.buffer.delay(dt)
+                desired = replace(desired, qd=np.zeros_like(desired.qd))
+                logged = "gate"
+            elif self.lift_gate.released_s > 0:
+                log.event(
+                    now,
+                    "lift_gate",
+                    held_s=self.lift_gate.released_s,
+                    legs=[LEG_NAMES[i] for i in self.lift_gate.short],
+                )
             if mode == "wait" and monitor.first_motion is not None:
                 wait_s += dt
             if mode == "replan":
@@ -405,7 +426,7 @@ class Executor:
                 self.runner.target if self.runner.target is not None else q_cmd,
                 self.integrator.delta,
                 self.controller.stiffness,
-                mode,
+                logged,
             )
             measured = self.runner.step(command)
             monitor.update(measured, desired)
@@ -662,6 +683,7 @@ class Executor:
         self.integrator.reset()
         self.stabilizer.reset()
         self.touchdown.reset()
+        self.lift_gate.reset()
         self.reflexes.reset()
 
     def _replant_motion(

@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 
 __all__ = ["RunLog", "MODES", "OTHER_PHASE"]
 
-MODES = ("walk", "wait", "recovery", "replan", "blend", "done")
+MODES = ("walk", "wait", "recovery", "replan", "blend", "done", "gate")
 """What the executor was doing, by the code stored in ``mode``."""
 
 OTHER_PHASE = 3

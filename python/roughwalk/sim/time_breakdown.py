@@ -14,6 +14,8 @@ each control tick:
   ``fitted_s``);
 * ``settle``: the last footstep's final four-foot phase;
 * ``wait``: holding for a footstep whose optimisation has not finished;
+* ``gate``: holding a footstep at its lift-off until the feet that stay
+  down bear (:class:`~roughwalk.sim.lift_gate.LiftGate`, opt-in);
 * ``reflex``: a reflex's recovery (the feet put down, the robot settling);
 * ``replan``: standing while the re-plan's charged time runs, and the blend
   into the new plan;
@@ -34,7 +36,7 @@ from roughwalk.sim.run_log import MODES, OTHER_PHASE, RunLog
 
 __all__ = ["FootstepTime", "TimeBreakdown", "time_breakdown"]
 
-_SHARES = ("shift", "swing", "stretch", "settle", "wait", "reflex", "replan")
+_SHARES = ("shift", "swing", "stretch", "settle", "wait", "gate", "reflex", "replan")
 _PHASES = ("shift", "swing", "settle")
 
 
@@ -50,11 +52,14 @@ class FootstepTime:
     stride_m: float
     advance_m: float
     stretch_s: float = 0.0
+    gate_s: float = 0.0
 
     @property
     def duration_s(self) -> float:
-        """The footstep's whole time [s], stretch and waits included."""
-        return self.shift_s + self.swing_s + self.stretch_s + self.settle_s + self.wait_s
+        """The footstep's whole time [s], stretch, waits and lift-off holds included."""
+        return (
+            self.shift_s + self.swing_s + self.stretch_s + self.settle_s + self.wait_s + self.gate_s
+        )
 
 
 @dataclass(frozen=True)
@@ -133,6 +138,7 @@ def time_breakdown(log: RunLog, start_s: float, stop_s: float) -> TimeBreakdown:
     step = np.asarray(log["step"])
     feet = np.asarray(log["feet_desired"], dtype=float)
     wait, walk, recovery = MODES.index("wait"), MODES.index("walk"), MODES.index("recovery")
+    gate = MODES.index("gate")
     starts = _fitted_lengths(log)
     footsteps: list[FootstepTime] = []
     current: dict[str, Any] | None = None
@@ -162,15 +168,17 @@ def time_breakdown(log: RunLog, start_s: float, stop_s: float) -> TimeBreakdown:
                 stride_m=float(np.nanmax(moved)),
                 advance_m=float(np.linalg.norm(centroid)),
                 stretch_s=c["stretch"],
+                gate_s=c["gate"],
             )
         )
 
     for k in np.flatnonzero(inside):
         d = float(dt[k])
-        if modes[k] == wait:
-            shares["wait"] += d
+        if modes[k] in (wait, gate):
+            share = "wait" if modes[k] == wait else "gate"
+            shares[share] += d
             if current is not None:
-                current["wait"] += d
+                current[share] += d
             continue
         if modes[k] != walk or phase[k] in (OTHER_PHASE, -1):
             shares["reflex" if modes[k] == recovery else "replan"] += d
@@ -180,7 +188,7 @@ def time_breakdown(log: RunLog, start_s: float, stop_s: float) -> TimeBreakdown:
         name = _PHASES[int(phase[k])]
         if current is None or current["step"] != int(step[k]):
             close(current)
-            current = dict.fromkeys(("shift", "swing", "stretch", "settle", "wait"), 0.0)
+            current = dict.fromkeys(("shift", "swing", "stretch", "settle", "wait", "gate"), 0.0)
             fitted = fitted_of(int(step[k]), float(t[k]))
             current.update(
                 step=int(step[k]),

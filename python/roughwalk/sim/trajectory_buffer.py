@@ -278,6 +278,15 @@ class TrajectoryBuffer:
             self._started_at = max(self._free_since, head.ready_at)
             started = True
 
+    def delay(self, dt: float) -> None:
+        """Stop the playing segment's clock for ``dt`` [s]: it, and what follows, play that late.
+
+        The next :meth:`advance` at ``now + dt`` then returns the state this
+        one did (a :class:`~roughwalk.sim.lift_gate.LiftGate` hold).
+        """
+        if self._current is not None:
+            self._started_at += dt
+
     def time_left(self, now: float) -> float:
         """Time [s] until the queued segments run out, from ``now``."""
         left = sum(s.duration for s in self._queue)

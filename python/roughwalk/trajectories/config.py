@@ -439,6 +439,22 @@ class ZmpConfig:
         the ZMP), and the rock runs get slower with more reflexes (round
         rocks 4.17 → 3.34 cm/s, 0 → 2 reflexes; sloped rocks 4.37 → 3.97;
         barrier 5.71 → 5.61, steps 5.21 → 5.35), so it stays 0.
+    com_margin:
+        Least distance [m] the planned CoM keeps inside each swing's support
+        triangle, from lift-off to touchdown (0: no check, the default). The
+        preview controller's CoM leads its ZMP: toward the next anchor
+        before a short shift, so the CoM of a swing ends nearer the
+        triangle's edge than the ZMP exit (``EXIT_MARGIN_FACTOR`` ×
+        ``chomp.zmp_margin``), and it lags into a triangle at lift-off. On
+        board AE (large rocks, seeds 0–15, the walk's defaults) the planned
+        CoM came within a median 0.7 cm of the edge over the first plans'
+        swings, a quarter within 0.25 cm, and the first reflex of 12 runs
+        followed such a swing. Where the CoM comes nearer than this, the
+        step's initial trajectory is built again: its swing's exit moves in
+        by the shortfall, and where the CoM is short at lift-off the shift
+        lengthens by a quarter (within ``timing.max_step_s``), up to four
+        times (``generator.COM_LIMIT``); the best is kept. Above the
+        shortcut's ``support_margin`` the lift-off shortfall cannot close.
     gravity:
         Gravitational acceleration [m/s²].
     """
@@ -449,11 +465,12 @@ class ZmpConfig:
     shortcut: bool = True
     support_margin: float = 0.015
     min_support_load: float = 0.0
+    com_margin: float = 0.0
     gravity: float = 9.81
 
     def __post_init__(self) -> None:
         _check_positive(self, ("tracking_weight", "jerk_weight", "gravity"), "zmp")
-        _check_nonnegative(self, ("support_margin", "min_support_load"), "zmp")
+        _check_nonnegative(self, ("support_margin", "min_support_load", "com_margin"), "zmp")
         if not (isinstance(self.preview_steps, int) and self.preview_steps >= 1):
             raise ConfigError(f"zmp.preview_steps must be an integer ≥ 1, got {self.preview_steps}")
 

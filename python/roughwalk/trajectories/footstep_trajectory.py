@@ -24,7 +24,7 @@ from roughwalk.trajectories.contact_forces import static_contact_forces
 from roughwalk.trajectories.euler import rpy_to_matrix, rpy_to_quat
 from roughwalk.trajectories.initial_trajectory import FootstepState
 from roughwalk.trajectories.step_report import StepReport, capsule_clearances, clearance_summary
-from roughwalk.trajectories.support_polygon import polygon_margin
+from roughwalk.trajectories.support_polygon import convex_polygon, polygon_margin
 from roughwalk.trajectories.whole_body import WholeBody
 
 __all__ = [
@@ -34,6 +34,7 @@ __all__ = [
     "swing_leg_angles",
     "phase_speed_ratios",
     "swing_speed_ratio",
+    "swing_com_margins",
 ]
 
 
@@ -153,6 +154,22 @@ def swing_speed_ratio(state: FootstepState, wb: WholeBody, rate_hz: float) -> fl
     q = swing_leg_angles(state, wb, time[airborne])
     qd = np.gradient(q, dt, axis=0, edge_order=2)
     return float(np.max(np.abs(qd) / wb.velocity_limit[state.step.leg]))
+
+
+def swing_com_margins(state: FootstepState) -> NDArray[np.float64]:
+    """Signed margins [m] of the planned CoM in the swing's support triangle, lift-off to touchdown.
+
+    The CoM is the preview controller's (the cart-table's), sampled at the
+    state's rate from ``lift_off`` to ``touchdown`` inclusive; the triangle is
+    the three supporting feet's x–y. Negative: outside. Empty if the step has
+    no swing samples.
+    """
+    lift, touch = state.lift_off, state.touchdown
+    if touch < lift:
+        return np.zeros(0)
+    triangle = convex_polygon(np.asarray(state.step.support_triangle, dtype=float)[:, :2])
+    margins, _ = polygon_margin(state.preview.com[lift : touch + 1], triangle)
+    return margins
 
 
 def phase_speed_ratios(state: FootstepState, wb: WholeBody, rate_hz: float) -> tuple[float, float]:

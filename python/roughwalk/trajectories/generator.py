@@ -37,6 +37,7 @@ from roughwalk.trajectories.footstep_trajectory import (
     FootstepTrajectory,
     phase_speed_ratios,
     resample_footstep,
+    swing_com_margins,
     swing_speed_ratio,
 )
 from roughwalk.trajectories.initial_trajectory import (
@@ -76,6 +77,13 @@ scale exactly with the step's duration."""
 
 RETIME_LIMIT = 3
 """Most re-timings of one initial trajectory before CHOMP is run on it anyway."""
+
+COM_LIMIT = 4
+"""Most rebuilds of one initial trajectory that keep its CoM inside the swing's
+triangle (``zmp.com_margin``)."""
+
+COM_SHIFT_FACTOR = 1.25
+"""Each rebuild for a CoM short of its margin at lift-off lengthens the shift by this."""
 
 SHIFT_SAMPLES = 21
 """Trunk poses along a shift at which the supporting legs' IK is solved to time it:
@@ -318,7 +326,7 @@ class FootstepTrajectoryGenerator:
         return np.einsum("kfi,kij->kfj", feet - base[:, None, :], rotation)
 
     def zmp_exit(
-        self, triangle: NDArray[np.float64], toward: NDArray[np.float64]
+        self, triangle: NDArray[np.float64], toward: NDArray[np.float64], inset: float = 0.0
     ) -> NDArray[np.float64]:
         """Where a swing on the support ``triangle`` leaves the ZMP, heading for ``toward`` (2,).
 
@@ -326,9 +334,10 @@ class FootstepTrajectoryGenerator:
         margin the support term asks for: with the support term's own
         margin, the ZMP ended up to 1.6 mm outside the triangle just before
         touchdown on LittleDog board AD, where the trunk is held and CHOMP
-        cannot pull it back.
+        cannot pull it back. ``inset`` [m] moves it that much farther in
+        (``zmp.com_margin``).
         """
-        margin = EXIT_MARGIN_FACTOR * self.config.chomp.zmp_margin
+        margin = EXIT_MARGIN_FACTOR * self.config.chomp.zmp_margin + inset
         return closest_point_in_triangle(toward, triangle, margin, self.min_support_share)
 
     def zmp_travels(self, seq: StepSequence, anchors: NDArray[np.float64]) -> list[float]:
@@ -460,8 +469,13 @@ class FootstepTrajectoryGenerator:
         start: StartState,
         timing: StepTiming,
         anchor: NDArray[np.float64],
+        exit_inset: float = 0.0,
     ) -> tuple[NDArray[np.float64], int]:
-        """ZMP reference samples over the preview window from step k, and its length N."""
+        """ZMP reference samples over the preview window from step k, and its length N.
+
+        ``exit_inset`` [m] moves step k's own swing exit that much farther
+        inside its triangle (``zmp.com_margin``); the later steps' are as planned.
+        """
         n_steps = len(prepared.sequence)
         anchors = prepared.anchors
         last = min(k + self.config.zmp.preview_steps, n_steps)
@@ -472,7 +486,9 @@ class FootstepTrajectoryGenerator:
         # Each swing moves the ZMP toward the next anchor (zmp_exit).
         steps = prepared.sequence.steps
         exits = [
-            self.zmp_exit(steps[k + j].support_triangle, points[j + 2])
+            self.zmp_exit(
+                steps[k + j].support_triangle, points[j + 2], exit_inset if j == 0 else 0.0
+            )
             if j + 2 < len(points)
             else points[j + 1]
             for j in range(len(window))
@@ -514,6 +530,7 @@ class FootstepTrajectoryGenerator:
         use_shortcut: bool = False,
         scale: float = 1.0,
         base: StepTiming | None = None,
+        exit_inset: float = 0.0,
     ) -> FootstepState:
         """The initial trajectory of step k (0-based) from ``start`` (§5.2), before CHOMP.
 
@@ -533,7 +550,7 @@ class FootstepTrajectoryGenerator:
         if self.config.timing.shift_travel_m > 0 and timing.shift_s < floor:
             timing = replace(timing, shift_s=floor)
         timing = timing.quantized(self.dt)
-        reference, horizon = self._window(prepared, k, start, timing, anchor)
+        reference, horizon = self._window(prepared, k, start, timing, anchor, exit_inset)
         support_z = float(np.mean(step.support_triangle[:, 2]))
         state = build_initial_trajectory(
             self.wb,
@@ -598,7 +615,55 @@ class FootstepTrajectoryGenerator:
             state = self.initial_state(
                 prepared, k, start, use_shortcut, 1.0, self._stretched(nominal, scale, stretch)
             )
-        return state, stretch
+        return self._com_kept(prepared, k, start, use_shortcut, state), stretch
+
+    def _com_kept(
+        self,
+        prepared: PreparedPlan,
+        k: int,
+        start: StartState,
+        use_shortcut: bool,
+        state: FootstepState,
+    ) -> FootstepState:
+        """Step k's initial trajectory rebuilt until its CoM keeps ``zmp.com_margin`` in its swing.
+
+        A CoM short of the margin at lift-off lengthens the shift by
+        :data:`COM_SHIFT_FACTOR` (it had not yet come into the triangle); one
+        short later in the swing moves the swing's ZMP exit in by the
+        shortfall (it led the ZMP toward the next anchor). At most
+        :data:`COM_LIMIT` rebuilds; the one whose CoM comes least near the
+        edge is returned (``state`` itself when it already keeps the margin).
+        """
+        cfg = self.config
+        need = cfg.zmp.com_margin
+        if need <= 0:
+            return state
+        margins = swing_com_margins(state)
+        if margins.size == 0 or float(margins.min()) >= need:
+            return state
+        best, best_low = state, float(margins.min())
+        timing, inset = state.timing, 0.0
+        for _ in range(COM_LIMIT):
+            changed = False
+            if margins[0] < need:
+                longer = replace(timing, shift_s=timing.shift_s * COM_SHIFT_FACTOR)
+                if longer.shift_s + longer.swing_s + longer.settle_s <= cfg.timing.max_step_s:
+                    timing, changed = longer, True
+            low = float(margins.min())
+            if low < need and low < float(margins[0]):
+                inset += need - low
+                changed = True
+            if not changed:
+                break
+            state = self.initial_state(prepared, k, start, use_shortcut, 1.0, timing, inset)
+            margins = swing_com_margins(state)
+            if margins.size == 0:
+                break
+            if float(margins.min()) > best_low:
+                best, best_low = state, float(margins.min())
+            if best_low >= need:
+                break
+        return best
 
     def _stretched(self, timing: StepTiming, scale: float, stretch: float) -> StepTiming:
         """``timing`` scaled by a restart's ``scale`` and the re-timing's ``stretch``.
