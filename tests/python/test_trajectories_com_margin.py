@@ -80,7 +80,7 @@ def test_the_com_margin_raises_every_short_swing_and_leaves_the_others(crawl) ->
     need = 0.01
     off = initial_states(robot, terrain, plan, 0.0)
     short = 0
-    for gen0, prepared, k, start, use, state in off:
+    for gen0, _prepared, k, start, use, state in off:
         cfg = rw.trajectories.trajectory_config(**{"zmp.com_margin": need})
         gen = FootstepTrajectoryGenerator(robot, terrain, config=cfg, sdf=gen0.sdf)
         kept, _ = gen._retimed(gen.prepare(plan), k, start, use, 1.0, 1.0)

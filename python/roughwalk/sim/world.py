@@ -45,6 +45,11 @@ _INTEGRATORS = {
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
 }
 
+_CONES = {
+    "pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL,
+    "elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC,
+}
+
 
 @dataclass(frozen=True)
 class GeomRoles:
@@ -127,6 +132,8 @@ class World:
         spec = mujoco.MjSpec.from_file(str(self.robot.mjcf_path))
         spec.option.timestep = 1.0 / cfg.physics_hz
         spec.option.integrator = _INTEGRATORS[cfg.integrator]
+        spec.option.cone = _CONES[contact.cone]
+        spec.option.impratio = contact.impratio
         spec.visual.global_.offwidth = max(spec.visual.global_.offwidth, 1280)
         spec.visual.global_.offheight = max(spec.visual.global_.offheight, 720)
         hf = self.terrain.to_mujoco_hfield(cfg.hfield_base)
