@@ -1,4 +1,4 @@
-"""The world's friction cone: μ every way with the elliptic cone, μ/√2 between the pyramid's axes."""
+"""The friction cone: μ every way with the elliptic cone, μ/√2 between the pyramid's axes."""
 
 from __future__ import annotations
 
