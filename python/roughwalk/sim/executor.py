@@ -31,10 +31,11 @@ import numpy as np
 
 from roughwalk.errors import PlanningError
 from roughwalk.planning.foothold_safety import resting_centres, steep_footholds
+from roughwalk.robots._rotations import quat_to_matrix
 from roughwalk.robots.canonical_frame import LEG_NAMES
 from roughwalk.sim.config import SimConfig
 from roughwalk.sim.cop_stabilizer import CopStabilizer
-from roughwalk.sim.foothold_snap import replant_targets
+from roughwalk.sim.foothold_snap import footholds_toward, replant_targets
 from roughwalk.sim.footstep_source import CRAWL_ORDER, FootstepSource, PlanAttempt, PlanStart
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
@@ -91,6 +92,12 @@ below 3: on board AE RH bore 10–25 N with a tick of nothing every 30 ms."""
 # How far [m] a foot may have settled from its planned foothold for a re-plan
 # to start from the planned one.
 _NEAR_PLAN_M = 0.025
+
+_RECENTRE_TRIES = 12
+"""Most plans one recentring step asks the planner for (``reflex.recentre_steps``)."""
+
+_RECENTRE_TARGETS = 3
+"""Most footholds tried per foot in one recentring step, nearest its nominal place first."""
 
 
 def nudged_stances(
@@ -209,6 +216,8 @@ class Executor:
         self._slides = 0
         self._slide_since: float | None = None
         self._recovery_footholds = np.zeros((4, 3))
+        # Steps toward the nominal stance taken in this recovery (``reflex.recentre_steps``).
+        self._recentred = 0
         # When each foot last bore load [s] (``reflex.loaded_window_s``).
         self._last_loaded = np.full(4, -np.inf)
 
@@ -351,7 +360,12 @@ class Executor:
                     ok, charged = self._replan(measured, desired, goal, now)
                     replan_until = now + charged
                     if not ok:
-                        failure = "re-planning failed: " + (log.events[-1].get("reason") or "")
+                        reason = log.events[-1].get("reason") or ""
+                        if self._recentre(measured, goal, now):
+                            # A foot steps toward its nominal place; then the
+                            # robot settles and re-plans again.
+                            continue
+                        failure = "re-planning failed: " + reason
                         break
                     mode = "replan"
                 elif self._plan is not None and self._plan.exhausted:
@@ -595,6 +609,7 @@ class Executor:
             self._reflex_next_leg = self._next_leg(desired)
             self._replanted = set()
             self._slides = 0
+            self._recentred = 0
             self._reflex_planned_feet = np.array(planned, dtype=float)
         # A foot that bore load a few ticks ago and still stands counts as loaded.
         in_contact = recently_loaded(self._last_loaded, now, 0.0) | (
@@ -858,6 +873,75 @@ class Executor:
                 now, "replant", leg=LEG_NAMES[leg], foot=measured.feet[leg], target=target
             )
             return True
+        return False
+
+    def _recentre(self, measured: MeasuredState, goal: np.ndarray, now: float) -> bool:
+        """Queue a step of a foot toward its nominal place after a failed re-plan; whether queued.
+
+        See ``reflex.recentre_steps``: the feet farthest from their nominal
+        places under the measured trunk (its position and heading) first,
+        each to the nearest foothold toward that place
+        (:func:`~roughwalk.sim.foothold_snap.footholds_toward`) that the
+        other three can hold the trunk for and from which the source's
+        planner finds a plan (from the measured trunk, as the re-plan asks);
+        :data:`_RECENTRE_TARGETS` footholds a foot, :data:`_RECENTRE_TRIES` plans at most.
+        """
+        cfg = self.config.reflex
+        planner = getattr(self.source, "planner", None)
+        if self._recentred >= cfg.recentre_steps or planner is None:
+            return False
+        rot = quat_to_matrix(measured.base_quat)
+        heading = float(np.arctan2(rot[1, 0], rot[0, 0]))
+        c, s = np.cos(heading), np.sin(heading)
+        nominal = (
+            np.asarray(self.robot.nominal_stance.feet, dtype=float)[:, :2]
+            @ np.array([[c, s], [-s, c]])
+            + np.asarray(measured.base_pos, dtype=float)[:2]
+        )
+        away = np.linalg.norm(np.asarray(measured.feet, dtype=float)[:, :2] - nominal, axis=1)
+        # As the re-plan asks (``reflex.replan_from_trunk``): certified from the measured trunk.
+        trunk = (
+            (measured.base_pos.copy(), measured.base_quat.copy()) if cfg.replan_from_trunk else None
+        )
+        tries = 0
+        for leg in np.argsort(-away, kind="stable"):
+            leg = int(leg)
+            targets = footholds_toward(
+                planner,
+                self.terrain_for_recovery,
+                measured.feet[leg],
+                nominal[leg],
+                cfg.recentre_radius_m,
+                self.robot.foot_radius,
+                front=leg < 2,
+            )
+            for target in targets[:_RECENTRE_TARGETS]:
+                if tries >= _RECENTRE_TRIES:
+                    return False
+                segments = self._replant_motion(measured, leg, target, now)
+                if segments is None:
+                    continue
+                feet = np.array(measured.feet, dtype=float)
+                feet[leg] = target
+                tries += 1
+                start = PlanStart(feet=feet, next_leg=None, trunk=trunk)
+                attempt = self.source.plan(start, goal, cfg.replan_budget_s)
+                if not attempt.ok:
+                    continue
+                self._recentred += 1
+                self._settle_deadline = None
+                for segment in segments:
+                    self.buffer.append(segment)
+                self.log.event(
+                    now,
+                    "recentre",
+                    leg=LEG_NAMES[leg],
+                    foot=measured.feet[leg],
+                    target=target,
+                    nominal=nominal[leg],
+                    plans_asked=tries,
+                )
+                return True
         return False
 
     def _settled(self, measured: MeasuredState, now: float) -> bool:

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from roughwalk.planning.footstep_planner import FootstepPlanner
     from roughwalk.terrain.terrain import Terrain
 
-__all__ = ["replant_targets", "snap_to_footholds"]
+__all__ = ["footholds_toward", "replant_targets", "snap_to_footholds"]
 
 
 def _foothold(
@@ -120,3 +120,41 @@ def replant_targets(
         for leg in sorted(moved)
         if steep[leg] and np.linalg.norm(snapped[leg, :2] - feet[leg, :2]) >= at_least
     ]
+
+
+def footholds_toward(
+    planner: FootstepPlanner,
+    terrain: Terrain,
+    foot: NDArray[np.float64],
+    toward: NDArray[np.float64],
+    radius: float,
+    foot_radius: float,
+    front: bool,
+    least_gain: float = 0.01,
+) -> NDArray[np.float64]:
+    """Foot centres (n, 3) [m] a foot at ``foot`` can step to, nearer ``toward`` (x–y) first.
+
+    The planner's lattice points within ``radius`` [m] of ``foot`` that are
+    footholds for a front or hind foot (``front``) and at least
+    ``least_gain`` [m] nearer ``toward`` than ``foot`` is, each at the
+    height where a sphere of ``foot_radius`` [m] rests there.
+    """
+    x0, y0, h, nx, ny = planner.lattice
+    reach = int(np.ceil(radius / h))
+    cell = np.round((np.asarray(foot, dtype=float)[:2] - (x0, y0)) / h)
+    i, j = np.meshgrid(np.arange(-reach, reach + 1), np.arange(-reach, reach + 1), indexing="ij")
+    cells = cell + np.stack([i.ravel(), j.ravel()], axis=1)
+    cells = cells[(cells[:, 0] >= 0) & (cells[:, 1] >= 0) & (cells[:, 0] < nx) & (cells[:, 1] < ny)]
+    xy = np.array([x0, y0]) + h * cells
+    xy = xy[np.linalg.norm(xy - np.asarray(foot, dtype=float)[:2], axis=1) <= radius + 1e-12]
+    if len(xy) == 0:
+        return np.zeros((0, 3))
+    xy = xy[_foothold(planner, terrain, xy, front)]
+    goal = np.asarray(toward, dtype=float)[:2]
+    now = float(np.linalg.norm(np.asarray(foot, dtype=float)[:2] - goal))
+    d = np.linalg.norm(xy - goal, axis=1)
+    keep = d <= now - least_gain
+    xy, d = xy[keep], d[keep]
+    if len(xy) == 0:
+        return np.zeros((0, 3))
+    return resting_centres(terrain, xy[np.argsort(d, kind="stable")], foot_radius)
