@@ -100,6 +100,12 @@ def test_a_stance_with_no_plan_steps_the_farthest_foot_toward_its_place(settled)
     last = executor.buffer.queued[-1].last()
     np.testing.assert_allclose(last.feet[RH], target, atol=1e-9)
     np.testing.assert_allclose(last.feet[:RH], AE_SEED16_FEET[:RH], atol=1e-9)
+    # Planning time is charged (``executor.compute_time_scale`` 1): the robot
+    # stands for the plans' wall time before it steps.
+    hold = executor.buffer.queued[0]
+    assert hold.kind == "recovery" and event["charged_s"] > 0
+    assert hold.duration == pytest.approx(event["charged_s"], abs=2e-3)
+    np.testing.assert_allclose(hold.last().feet, AE_SEED16_FEET, atol=1e-9)
     # One step per reflex: the second call does nothing.
     assert not executor._recentre(measured, AE_SEED16_GOAL, 5.0)
 

@@ -361,7 +361,7 @@ class Executor:
                     replan_until = now + charged
                     if not ok:
                         reason = log.events[-1].get("reason") or ""
-                        if self._recentre(measured, goal, now):
+                        if self._recentre(measured, goal, now, charged):
                             # A foot steps toward its nominal place; then the
                             # robot settles and re-plans again.
                             continue
@@ -875,7 +875,9 @@ class Executor:
             return True
         return False
 
-    def _recentre(self, measured: MeasuredState, goal: np.ndarray, now: float) -> bool:
+    def _recentre(
+        self, measured: MeasuredState, goal: np.ndarray, now: float, charged: float = 0.0
+    ) -> bool:
         """Queue a step of a foot toward its nominal place after a failed re-plan; whether queued.
 
         See ``reflex.recentre_steps``: the feet farthest from their nominal
@@ -885,6 +887,8 @@ class Executor:
         other three can hold the trunk for and from which the source's
         planner finds a plan (from the measured trunk, as the re-plan asks);
         :data:`_RECENTRE_TARGETS` footholds a foot, :data:`_RECENTRE_TRIES` plans at most.
+        The robot first stands for the failed re-plan's ``charged`` time [s]
+        and the charged wall time of these plans, then steps.
         """
         cfg = self.config.reflex
         planner = getattr(self.source, "planner", None)
@@ -904,6 +908,7 @@ class Executor:
             (measured.base_pos.copy(), measured.base_quat.copy()) if cfg.replan_from_trunk else None
         )
         tries = 0
+        began = time.perf_counter()
         for leg in np.argsort(-away, kind="stable"):
             leg = int(leg)
             targets = footholds_toward(
@@ -930,6 +935,11 @@ class Executor:
                     continue
                 self._recentred += 1
                 self._settle_deadline = None
+                wait = charged + self._charge(time.perf_counter() - began)
+                if wait > 0:
+                    self.buffer.append(
+                        hold_segment(self._standing(measured), wait, now, "recovery")
+                    )
                 for segment in segments:
                     self.buffer.append(segment)
                 self.log.event(
@@ -940,6 +950,7 @@ class Executor:
                     target=target,
                     nominal=nominal[leg],
                     plans_asked=tries,
+                    charged_s=wait,
                 )
                 return True
         return False
