@@ -72,6 +72,16 @@ def test_the_world_takes_the_cone_and_impratio(littledog) -> None:
     assert world.model.opt.impratio == pytest.approx(10.0)
 
 
+def test_by_default_the_world_keeps_each_robot_files_cone(littledog) -> None:
+    flat = roughwalk.load_terrain("flat")
+    anymal = World(roughwalk.load_robot("anymal_c"), flat)
+    assert anymal.model.opt.cone == mujoco.mjtCone.mjCONE_ELLIPTIC
+    assert anymal.model.opt.impratio == pytest.approx(100.0)
+    dog = World(littledog, flat)
+    assert dog.model.opt.cone == mujoco.mjtCone.mjCONE_PYRAMIDAL
+    assert dog.model.opt.impratio == pytest.approx(1.0)
+
+
 def test_contact_config_rejects_an_unknown_cone_and_a_nonpositive_impratio() -> None:
     with pytest.raises(ConfigError, match="cone"):
         ContactConfig(cone="round")

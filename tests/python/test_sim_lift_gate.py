@@ -123,15 +123,19 @@ def test_config_rejects_nonsense() -> None:
             LiftGateConfig(**bad)
 
 
-def test_a_gated_walk_on_flat_ground_reaches_the_goal_and_logs_its_holds(littledog) -> None:
-    """Flat ground with the gate on: every lift-off's staying feet bear, or a hold says why."""
+def test_a_strict_gate_holds_the_walk_and_the_holds_are_its_gate_share(littledog) -> None:
+    """Flat ground, every staying foot asked to bear its whole planned load: lift-offs wait."""
     terrain = roughwalk.load_terrain("flat")
-    config = SimConfig(lift_gate=LiftGateConfig(enabled=True))
-    result = run(littledog, terrain, (0.3, 0.0, 0.0), (0.6, 0.0), config=config)
-    assert result.outcome.success, result.outcome.reason
-    holds = result.log.events_of("lift_gate")
-    split = result.outcome.extra["time_breakdown"]
-    assert split["gate_s"] == pytest.approx(sum(e["held_s"] for e in holds), abs=3 * DT)
-    for e in holds:
-        assert 0 < e["held_s"] <= LiftGateConfig().max_hold_s + 1e-9
-        assert e["legs"]
+    strict = LiftGateConfig(enabled=True, least_n=1e3, fraction=1.0, max_hold_s=0.05)
+    gated = run(littledog, terrain, (0.3, 0.0, 0.0), (0.6, 0.0), config=SimConfig(lift_gate=strict))
+    plain = run(littledog, terrain, (0.3, 0.0, 0.0), (0.6, 0.0), config=SimConfig())
+    assert gated.outcome.success and plain.outcome.success, gated.outcome.reason
+    holds = gated.log.events_of("lift_gate")
+    assert len(holds) >= 4
+    assert all(0 < e["held_s"] <= strict.max_hold_s + 1e-9 and e["legs"] for e in holds)
+    held = sum(e["held_s"] for e in holds)
+    split = gated.outcome.extra["time_breakdown"]
+    assert split["gate_s"] == pytest.approx(held, abs=3 * DT)
+    assert plain.outcome.extra["time_breakdown"]["gate_s"] == 0.0
+    # The plan's clock stood still for the holds: the walk took that much longer.
+    assert gated.outcome.time_s > plain.outcome.time_s + 0.5 * held

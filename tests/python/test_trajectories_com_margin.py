@@ -97,17 +97,6 @@ def test_the_com_margin_raises_every_short_swing_and_leaves_the_others(crawl) ->
     assert short >= len(off) // 2
 
 
-def test_com_margin_zero_is_the_old_trajectory(crawl) -> None:
-    robot, terrain, plan = crawl
-    default = initial_states(robot, terrain, plan, 0.0)[:3]
-    cfg = rw.trajectories.trajectory_config()
-    assert cfg.zmp.com_margin == 0.0
-    gen = FootstepTrajectoryGenerator(robot, terrain, config=cfg, sdf=default[0][0].sdf)
-    for _, _, k, start, use, state in default:
-        again, _ = gen._retimed(gen.prepare(plan), k, start, use, 1.0, 1.0)
-        np.testing.assert_array_equal(again.preview.com, state.preview.com)
-
-
 def test_config_rejects_a_negative_com_margin() -> None:
     with pytest.raises(ConfigError, match="com_margin"):
         rw.trajectories.trajectory_config(**{"zmp.com_margin": -0.01})

@@ -374,25 +374,22 @@ class Executor:
                 mode = "walk"
             if mode in ("walk", "wait"):
                 mode = "wait" if waiting else "walk"
-            logged = mode
-            if (
-                mode == "walk"
-                and current is not None
-                and desired is not None
-                and self.lift_gate.hold(current, now - self.buffer.started_at, desired, measured)
-            ):
-                # A foot that stays down does not bear yet: the plan's clock stops
-                # at the lift-off, every joint target held still.
-                self.buffer.delay(dt)
-                desired = replace(desired, qd=np.zeros_like(desired.qd))
-                logged = "gate"
-            elif self.lift_gate.released_s > 0:
-                log.event(
-                    now,
-                    "lift_gate",
-                    held_s=self.lift_gate.released_s,
-                    legs=[LEG_NAMES[i] for i in self.lift_gate.short],
-                )
+            gated = False
+            if mode == "walk" and current is not None and desired is not None:
+                tau = now - self.buffer.started_at
+                gated = self.lift_gate.hold(current, tau, desired, measured)
+                if gated:
+                    # A foot that stays down does not bear yet: the plan's clock
+                    # stops at the lift-off and the joint targets stand still.
+                    self.buffer.delay(dt)
+                    desired = replace(desired, qd=np.zeros_like(desired.qd))
+                elif self.lift_gate.released_s > 0:
+                    log.event(
+                        now,
+                        "lift_gate",
+                        held_s=self.lift_gate.released_s,
+                        legs=[LEG_NAMES[i] for i in self.lift_gate.short],
+                    )
             if mode == "wait" and monitor.first_motion is not None:
                 wait_s += dt
             if mode == "replan":
@@ -440,7 +437,8 @@ class Executor:
                 self.runner.target if self.runner.target is not None else q_cmd,
                 self.integrator.delta,
                 self.controller.stiffness,
-                logged,
+                # A reflex fired on a held tick ends the hold: the tick is the recovery's.
+                "gate" if gated and mode == "walk" else mode,
             )
             measured = self.runner.step(command)
             monitor.update(measured, desired)
@@ -885,10 +883,12 @@ class Executor:
         each to the nearest foothold toward that place
         (:func:`~roughwalk.sim.foothold_snap.footholds_toward`) that the
         other three can hold the trunk for and from which the source's
-        planner finds a plan (from the measured trunk, as the re-plan asks);
+        planner finds a plan (from the measured trunk, the leg due to lift
+        first, as the re-plan asks; the plan is asked again by that re-plan);
         :data:`_RECENTRE_TARGETS` footholds a foot, :data:`_RECENTRE_TRIES` plans at most.
         The robot first stands for the failed re-plan's ``charged`` time [s]
-        and the charged wall time of these plans, then steps.
+        and the charged wall time of these plans, then steps (the stand and
+        the step count as the reflex's time, the recovery's).
         """
         cfg = self.config.reflex
         planner = getattr(self.source, "planner", None)
@@ -907,6 +907,8 @@ class Executor:
         trunk = (
             (measured.base_pos.copy(), measured.base_quat.copy()) if cfg.replan_from_trunk else None
         )
+        # The leg the re-plan after the step lifts first, as it will ask.
+        due = getattr(self, "_reflex_next_leg", None)
         tries = 0
         began = time.perf_counter()
         for leg in np.argsort(-away, kind="stable"):
@@ -929,7 +931,7 @@ class Executor:
                 feet = np.array(measured.feet, dtype=float)
                 feet[leg] = target
                 tries += 1
-                start = PlanStart(feet=feet, next_leg=None, trunk=trunk)
+                start = PlanStart(feet=feet, next_leg=due, trunk=trunk)
                 attempt = self.source.plan(start, goal, cfg.replan_budget_s)
                 if not attempt.ok:
                     continue

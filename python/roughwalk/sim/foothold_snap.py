@@ -137,7 +137,8 @@ def footholds_toward(
     The planner's lattice points within ``radius`` [m] of ``foot`` that are
     footholds for a front or hind foot (``front``) and at least
     ``least_gain`` [m] nearer ``toward`` than ``foot`` is, each at the
-    height where a sphere of ``foot_radius`` [m] rests there.
+    height where a sphere of ``foot_radius`` [m] rests there. (The planner's
+    footholds: with ``footstep.max_foothold_slope`` a walk's refuse faces.)
     """
     x0, y0, h, nx, ny = planner.lattice
     reach = int(np.ceil(radius / h))
@@ -151,9 +152,9 @@ def footholds_toward(
         return np.zeros((0, 3))
     xy = xy[_foothold(planner, terrain, xy, front)]
     goal = np.asarray(toward, dtype=float)[:2]
-    now = float(np.linalg.norm(np.asarray(foot, dtype=float)[:2] - goal))
+    from_foot = float(np.linalg.norm(np.asarray(foot, dtype=float)[:2] - goal))
     d = np.linalg.norm(xy - goal, axis=1)
-    keep = d <= now - least_gain
+    keep = d <= from_foot - least_gain
     xy, d = xy[keep], d[keep]
     if len(xy) == 0:
         return np.zeros((0, 3))

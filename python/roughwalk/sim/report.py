@@ -116,6 +116,7 @@ def write_report(
             f"shifts {split['shift_s']:.1f} s, swings {split['swing_s']:.1f} s, "
             f"stretched {split.get('stretch_s', 0.0):.1f} s, "
             f"settling {split['settle_s']:.1f} s, waits {split['wait_s']:.1f} s, "
+            f"lift-off holds {split.get('gate_s', 0.0):.1f} s, "
             f"reflexes {split['reflex_s']:.1f} s, re-plans {split.get('replan_s', 0.0):.1f} s; "
             f"{split['footsteps']} footsteps, "
             f"mean stride {100 * split['mean_stride_m']:.1f} cm"
@@ -131,7 +132,19 @@ def write_report(
     shown = [
         e
         for e in events
-        if e.get("kind") in ("reflex", "replan", "push", "friction", "fall", "goal", "plan", "end")
+        if e.get("kind")
+        in (
+            "reflex",
+            "replan",
+            "recentre",
+            "lift_gate",
+            "push",
+            "friction",
+            "fall",
+            "goal",
+            "plan",
+            "end",
+        )
     ]
     if shown:
         parts.append("<h2>Events</h2><table><tr><th>t [s]</th><th>event</th><th>detail</th></tr>")

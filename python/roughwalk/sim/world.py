@@ -132,8 +132,11 @@ class World:
         spec = mujoco.MjSpec.from_file(str(self.robot.mjcf_path))
         spec.option.timestep = 1.0 / cfg.physics_hz
         spec.option.integrator = _INTEGRATORS[cfg.integrator]
-        spec.option.cone = _CONES[contact.cone]
-        spec.option.impratio = contact.impratio
+        # None keeps the robot file's own (ANYmal C's sets an elliptic cone, impratio 100).
+        if contact.cone is not None:
+            spec.option.cone = _CONES[contact.cone]
+        if contact.impratio is not None:
+            spec.option.impratio = contact.impratio
         spec.visual.global_.offwidth = max(spec.visual.global_.offwidth, 1280)
         spec.visual.global_.offheight = max(spec.visual.global_.offheight, 720)
         hf = self.terrain.to_mujoco_hfield(cfg.hfield_base)

@@ -161,12 +161,9 @@ def swing_com_margins(state: FootstepState) -> NDArray[np.float64]:
 
     The CoM is the preview controller's (the cart-table's), sampled at the
     state's rate from ``lift_off`` to ``touchdown`` inclusive; the triangle is
-    the three supporting feet's x–y. Negative: outside. Empty if the step has
-    no swing samples.
+    the three supporting feet's x–y. Negative: outside.
     """
     lift, touch = state.lift_off, state.touchdown
-    if touch < lift:
-        return np.zeros(0)
     triangle = convex_polygon(np.asarray(state.step.support_triangle, dtype=float)[:, :2])
     margins, _ = polygon_margin(state.preview.com[lift : touch + 1], triangle)
     return margins

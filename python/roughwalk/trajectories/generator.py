@@ -631,15 +631,17 @@ class FootstepTrajectoryGenerator:
         :data:`COM_SHIFT_FACTOR` (it had not yet come into the triangle); one
         short later in the swing moves the swing's ZMP exit in by the
         shortfall (it led the ZMP toward the next anchor). At most
-        :data:`COM_LIMIT` rebuilds; the one whose CoM comes least near the
-        edge is returned (``state`` itself when it already keeps the margin).
+        :data:`COM_LIMIT` rebuilds; of those whose swing keeps the joint
+        speed limits, the one whose CoM comes least near the edge is
+        returned (``state`` itself when it already keeps the margin or no
+        rebuild does better).
         """
         cfg = self.config
         need = cfg.zmp.com_margin
         if need <= 0:
             return state
         margins = swing_com_margins(state)
-        if margins.size == 0 or float(margins.min()) >= need:
+        if float(margins.min()) >= need:
             return state
         best, best_low = state, float(margins.min())
         timing, inset = state.timing, 0.0
@@ -647,7 +649,7 @@ class FootstepTrajectoryGenerator:
             changed = False
             if margins[0] < need:
                 longer = replace(timing, shift_s=timing.shift_s * COM_SHIFT_FACTOR)
-                if longer.shift_s + longer.swing_s + longer.settle_s <= cfg.timing.max_step_s:
+                if longer.shift_s + longer.swing_s <= cfg.timing.max_step_s:
                     timing, changed = longer, True
             low = float(margins.min())
             if low < need and low < float(margins[0]):
@@ -656,12 +658,13 @@ class FootstepTrajectoryGenerator:
             if not changed:
                 break
             state = self.initial_state(prepared, k, start, use_shortcut, 1.0, timing, inset)
-            margins = swing_com_margins(state)
-            if margins.size == 0:
-                break
-            if float(margins.min()) > best_low:
+            before, margins = low, swing_com_margins(state)
+            # A rebuild whose swing breaks a joint's speed limit is not kept.
+            fast = swing_speed_ratio(state, self.wb, cfg.control_rate_hz) > 1.0
+            if not fast and float(margins.min()) > best_low:
                 best, best_low = state, float(margins.min())
-            if best_low >= need:
+            # The plan's last step has no exit to move: nothing more to gain.
+            if best_low >= need or abs(float(margins.min()) - before) < 1e-9:
                 break
         return best
 
