@@ -536,7 +536,8 @@ class TrajoptConfig:
         default: from ``learned_fixed_durations`` on the double pallet's
         held-out seeds 0–3 it tracks 117/120 at 0 iterations (115 without)
         and 117/120 at 5 (117 without: seed 3 task 24 gained, seed 0 task
-        26 lost); single pallet seeds 0–1 60/60 at 5 (session 20).
+        26 lost); single pallet seeds 0–1 60/60 at 5 (session 20), seeds
+        0–2 90/90 at 0 and seed 2 30/30 at 5 (session 21): 90/90 at both.
     body_model:
         "robot" (single rigid body from the Robot's model) or "towr_anymal"
         (TOWR's published ANYmal values).
