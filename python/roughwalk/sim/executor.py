@@ -36,7 +36,13 @@ from roughwalk.robots.canonical_frame import LEG_NAMES
 from roughwalk.sim.config import SimConfig
 from roughwalk.sim.cop_stabilizer import CopStabilizer
 from roughwalk.sim.foothold_snap import footholds_toward, replant_targets
-from roughwalk.sim.footstep_source import CRAWL_ORDER, FootstepSource, PlanAttempt, PlanStart
+from roughwalk.sim.footstep_source import (
+    CRAWL_ORDER,
+    FootstepSource,
+    PlanAttempt,
+    PlanStart,
+    nominal_feet_xy,
+)
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
 from roughwalk.sim.lift_gate import LiftGate
@@ -896,12 +902,8 @@ class Executor:
             return False
         rot = quat_to_matrix(measured.base_quat)
         heading = float(np.arctan2(rot[1, 0], rot[0, 0]))
-        c, s = np.cos(heading), np.sin(heading)
-        nominal = (
-            np.asarray(self.robot.nominal_stance.feet, dtype=float)[:, :2]
-            @ np.array([[c, s], [-s, c]])
-            + np.asarray(measured.base_pos, dtype=float)[:2]
-        )
+        x, y = (float(v) for v in measured.base_pos[:2])
+        nominal = nominal_feet_xy(self.robot, (x, y, heading))
         away = np.linalg.norm(np.asarray(measured.feet, dtype=float)[:, :2] - nominal, axis=1)
         # As the re-plan asks (``reflex.replan_from_trunk``): certified from the measured trunk.
         trunk = (

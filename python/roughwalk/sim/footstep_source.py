@@ -46,6 +46,7 @@ __all__ = [
     "FOOTSTEP_PREFIX",
     "planner_config",
     "split_footstep_settings",
+    "nominal_feet_xy",
 ]
 
 CRAWL_ORDER = ("LH", "LF", "RH", "RF")
@@ -403,14 +404,19 @@ class PlannerSource:
 
     def _stance_at(self, pose: tuple[float, float, float]) -> NDArray[np.float64]:
         """The nominal stance's feet (4, 3) [m] at the trunk pose (x, y, yaw), on the terrain."""
-        x, y, yaw = pose
-        c, s = math.cos(yaw), math.sin(yaw)
-        local = np.asarray(self.robot.nominal_stance.feet, dtype=float)[:, :2]
-        xy = np.column_stack(
-            (x + c * local[:, 0] - s * local[:, 1], y + s * local[:, 0] + c * local[:, 1])
-        )
+        xy = nominal_feet_xy(self.robot, pose)
         z = np.asarray(self.terrain.height(xy), dtype=float) + self.robot.foot_radius
         return np.column_stack((xy, z))
+
+
+def nominal_feet_xy(robot: Robot, pose: tuple[float, float, float]) -> NDArray[np.float64]:
+    """Where the nominal stance puts the feet (4, 2) [m] under the trunk pose (x, y, yaw)."""
+    x, y, yaw = pose
+    c, s = math.cos(yaw), math.sin(yaw)
+    local = np.asarray(robot.nominal_stance.feet, dtype=float)[:, :2]
+    return np.column_stack(
+        (x + c * local[:, 0] - s * local[:, 1], y + s * local[:, 0] + c * local[:, 1])
+    )
 
 
 def default_source(robot: Robot, terrain: Terrain, **options: Any) -> FootstepSource:
