@@ -553,3 +553,38 @@ def test_the_descent_exemption_needs_the_robot_to_lean_onto_the_light_foot(littl
     assert _recorded_load_hits(littledog, leaning, rocks)[0] == 45
     any_lean = ReflexConfig(**exempt, foot_force_descent_lean_m=-1.0)  # session 16's exemption
     assert _recorded_load_hits(littledog, any_lean, rocks) == []
+
+
+def _pairs(world: World) -> set[frozenset[str]]:
+    """Body-name pairs of the active contacts."""
+    m, d = world.model, world.data
+    return {
+        frozenset(
+            (m.body(m.geom_bodyid[c.geom1]).name, m.body(m.geom_bodyid[c.geom2]).name)
+        )
+        for c in d.contact[: d.ncon]
+    }
+
+
+def test_littledog_legs_never_touch_its_trunk_hull_but_the_trunk_meets_the_ground(
+    littledog, flat
+) -> None:
+    # The trunk box is a hull wider than the body between the hip joints: with
+    # the nominal hip flexion and knee angles the right hind upper leg meets
+    # it from 0.25 rad of hip roll, which rocky starts hold. No leg link may
+    # touch it, at any hip roll of its range; the trunk still meets the terrain.
+    world = World(littledog, flat)
+    m, d = world.model, world.data
+    home = m.key("home").qpos.copy()
+    legs = [b for bodies in littledog.description.leg_bodies for b in bodies]
+    for roll in np.linspace(-0.6, 0.6, 13):
+        d.qpos[:] = home
+        d.qpos[2] += 0.3
+        d.qpos[world.joint_qpos[0::3]] = roll
+        mujoco.mj_forward(m, d)
+        touching = [p for p in _pairs(world) if "trunk" in p and p - {"trunk"} <= set(legs)]
+        assert not touching, f"hip roll {roll:.2f} rad: {touching}"
+    d.qpos[:] = home
+    d.qpos[2] = 0.02  # the trunk lowered onto the floor, legs splayed through it
+    mujoco.mj_forward(m, d)
+    assert any("trunk" in p and "world" in p for p in _pairs(world))
