@@ -588,3 +588,34 @@ def test_littledog_legs_never_touch_its_trunk_hull_but_the_trunk_meets_the_groun
     d.qpos[2] = 0.02  # the trunk lowered onto the floor, legs splayed through it
     mujoco.mj_forward(m, d)
     assert any("trunk" in p and "world" in p for p in _pairs(world))
+
+
+def test_a_robot_file_whose_legs_touch_its_trunk_shows_as_self_contacts(
+    littledog, flat, tmp_path
+) -> None:
+    # A user's MJCF with a trunk hull the legs reach: the measured state says
+    # so on every tick it happens, and the run's outcome counts the ticks.
+    import re
+
+    from roughwalk.sim.measured_state import measure
+    from roughwalk.sim.outcome import OutcomeMonitor
+
+    text = littledog.mjcf_path.read_text()
+    without = re.sub(r"<contact>.*?</contact>", "", text, flags=re.S)
+    assert without != text
+    path = tmp_path / "littledog_no_excludes.xml"
+    path.write_text(without)
+    rubbing = roughwalk.load_robot(path)
+    for robot, expected in ((littledog, False), (rubbing, True)):
+        world = World(robot, flat)
+        m, d = world.model, world.data
+        d.qpos[:] = m.key("home").qpos
+        d.qpos[2] += 0.3
+        d.qpos[world.joint_qpos[9]] = 0.5  # RH hip roll towards the trunk
+        mujoco.mj_forward(m, d)
+        state = measure(world)
+        assert state.self_contact is expected
+        monitor = OutcomeMonitor(np.array([1.0, 0.0]), np.zeros(2))
+        monitor.update(state, None)
+        monitor.update(state, None)
+        assert monitor.self_contacts == (2 if expected else 0)

@@ -48,6 +48,10 @@ class MeasuredState:
         True when a trunk geom touches the terrain.
     shin_contact:
         (4,) True when a leg geom other than the foot touches the terrain.
+    self_contact:
+        True when two of the robot's own bodies touch (a leg and the trunk,
+        or two legs): contacts no planner here models, which a robot file's
+        collision shapes can make by mistake (a trunk hull the legs rub).
     actuator_force:
         (12,) joint torques the servos produced on the last physics step [N·m].
     """
@@ -65,6 +69,7 @@ class MeasuredState:
     trunk_contact: bool
     shin_contact: NDArray[np.bool_]
     actuator_force: NDArray[np.float64]
+    self_contact: bool = False
 
     @property
     def rotation(self) -> NDArray[np.float64]:
@@ -94,6 +99,7 @@ def measure(world: World) -> MeasuredState:
     forces = np.zeros((4, 3))
     trunk = False
     shin = np.zeros(4, dtype=bool)
+    self_contact = False
     wrench = np.zeros(6)
     terrain = roles.terrain
     for i in range(d.ncon):
@@ -104,6 +110,7 @@ def measure(world: World) -> MeasuredState:
         elif g2 == terrain:
             other, sign = g1, -1.0
         else:
+            self_contact = self_contact or bool(roles.leg[g1] >= -1 and roles.leg[g2] >= -1)
             continue
         leg = int(roles.leg[other])
         if leg == -1:
@@ -135,4 +142,5 @@ def measure(world: World) -> MeasuredState:
         trunk_contact=trunk,
         shin_contact=shin,
         actuator_force=d.actuator_force[world.actuator_of_joint].copy(),
+        self_contact=self_contact,
     )

@@ -58,6 +58,9 @@ class Outcome:
         Largest trunk roll and pitch magnitudes [rad].
     shin_contacts:
         Control ticks on which a leg other than its foot touched the terrain.
+    self_contacts:
+        Control ticks on which two of the robot's bodies touched each other
+        (:attr:`~roughwalk.sim.measured_state.MeasuredState.self_contact`).
     steps:
         Footsteps executed to completion.
     """
@@ -77,6 +80,7 @@ class Outcome:
     max_roll_rad: float = 0.0
     max_pitch_rad: float = 0.0
     shin_contacts: int = 0
+    self_contacts: int = 0
     steps: int = 0
     extra: dict[str, Any] = field(default_factory=dict)
 
@@ -119,6 +123,7 @@ class OutcomeMonitor:
         self.max_roll = 0.0
         self.max_pitch = 0.0
         self.shin_contacts = 0
+        self.self_contacts = 0
         self._anchor = np.full((4, 3), np.nan)
         self._slipped = np.zeros(4, dtype=bool)
         self.last_centroid = self.start_centroid.copy()
@@ -150,6 +155,7 @@ class OutcomeMonitor:
         elif abs(pitch) > cfg.max_pitch_rad:
             self._fall(t, f"pitched {math.degrees(pitch):.0f}° at t = {t:.2f} s")
         self.shin_contacts += int(np.any(measured.shin_contact))
+        self.self_contacts += int(measured.self_contact)
         centroid = measured.feet_centroid[:2]
         self.last_centroid = centroid
         if (
@@ -228,6 +234,7 @@ class OutcomeMonitor:
             max_roll_rad=self.max_roll,
             max_pitch_rad=self.max_pitch,
             shin_contacts=self.shin_contacts,
+            self_contacts=self.self_contacts,
             steps=steps,
             extra=dict(extra or {}),
         )
