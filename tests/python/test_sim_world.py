@@ -559,9 +559,7 @@ def _pairs(world: World) -> set[frozenset[str]]:
     """Body-name pairs of the active contacts."""
     m, d = world.model, world.data
     return {
-        frozenset(
-            (m.body(m.geom_bodyid[c.geom1]).name, m.body(m.geom_bodyid[c.geom2]).name)
-        )
+        frozenset((m.body(m.geom_bodyid[c.geom1]).name, m.body(m.geom_bodyid[c.geom2]).name))
         for c in d.contact[: d.ncon]
     }
 
