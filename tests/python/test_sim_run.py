@@ -340,6 +340,7 @@ def test_cli_run_writes_json_report_and_replays(tmp_path: Path) -> None:
     assert doc["speed_cm_s"] > 0 and doc["reflexes"] == 0 and doc["replans"] == 0
     page = (out / "index.html").read_text()
     assert "path.png" in page and "tracking.png" in page and "Reached the goal" in page
+    assert doc["self_contacts"] == 0 and "robot touching itself" in page
     assert doc["extra"]["time_breakdown"]["swing_s"] > 0 and "where the time went" in page
     assert main(["run", "--terrain", "flat", "--start", "0,0", "--goal", "x,1"]) == 1
     from roughwalk.sim.video import gl_backend

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import mujoco
 import numpy as np
@@ -15,6 +16,8 @@ from roughwalk.robots.registry import list_robots
 from roughwalk.sim.config import IntegratorConfig, ReflexConfig, WorldConfig
 from roughwalk.sim.joint_controller import JointController
 from roughwalk.sim.leg_integrator import LegIntegrator
+from roughwalk.sim.measured_state import measure
+from roughwalk.sim.outcome import OutcomeMonitor
 from roughwalk.sim.recovery import hold_segment, pose_segment
 from roughwalk.sim.reflexes import ReflexMonitor, lean_toward
 from roughwalk.sim.runner import Runner, ServoCommand
@@ -569,16 +572,19 @@ def test_littledog_legs_never_touch_its_trunk_hull_but_the_trunk_meets_the_groun
 ) -> None:
     # The trunk box is a hull wider than the body between the hip joints: with
     # the nominal hip flexion and knee angles the right hind upper leg meets
-    # it from 0.25 rad of hip roll, which rocky starts hold. No leg link may
-    # touch it, at any hip roll of its range; the trunk still meets the terrain.
+    # it from about 0.20 rad of hip roll, which rocky starts hold. No leg link
+    # may touch it, at any hip roll of its range; the trunk still meets the
+    # terrain.
     world = World(littledog, flat)
     m, d = world.model, world.data
     home = m.key("home").qpos.copy()
     legs = [b for bodies in littledog.description.leg_bodies for b in bodies]
+    assert len(legs) == 12
+    rolls = [m.joint(f"{leg}_HAA").qposadr[0] for leg in ("LF", "RF", "LH", "RH")]
     for roll in np.linspace(-0.6, 0.6, 13):
         d.qpos[:] = home
         d.qpos[2] += 0.3
-        d.qpos[world.joint_qpos[0::3]] = roll
+        d.qpos[rolls] = roll
         mujoco.mj_forward(m, d)
         touching = [p for p in _pairs(world) if "trunk" in p and p - {"trunk"} <= set(legs)]
         assert not touching, f"hip roll {roll:.2f} rad: {touching}"
@@ -593,11 +599,6 @@ def test_a_robot_file_whose_legs_touch_its_trunk_shows_as_self_contacts(
 ) -> None:
     # A user's MJCF with a trunk hull the legs reach: the measured state says
     # so on every tick it happens, and the run's outcome counts the ticks.
-    import re
-
-    from roughwalk.sim.measured_state import measure
-    from roughwalk.sim.outcome import OutcomeMonitor
-
     text = littledog.mjcf_path.read_text()
     without = re.sub(r"<contact>.*?</contact>", "", text, flags=re.S)
     assert without != text
@@ -609,7 +610,7 @@ def test_a_robot_file_whose_legs_touch_its_trunk_shows_as_self_contacts(
         m, d = world.model, world.data
         d.qpos[:] = m.key("home").qpos
         d.qpos[2] += 0.3
-        d.qpos[world.joint_qpos[9]] = 0.5  # RH hip roll towards the trunk
+        d.qpos[m.joint("RH_HAA").qposadr[0]] = 0.5  # towards the trunk
         mujoco.mj_forward(m, d)
         state = measure(world)
         assert state.self_contact is expected

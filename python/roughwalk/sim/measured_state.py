@@ -48,12 +48,13 @@ class MeasuredState:
         True when a trunk geom touches the terrain.
     shin_contact:
         (4,) True when a leg geom other than the foot touches the terrain.
-    self_contact:
-        True when two of the robot's own bodies touch (a leg and the trunk,
-        or two legs): contacts no planner here models, which a robot file's
-        collision shapes can make by mistake (a trunk hull the legs rub).
     actuator_force:
         (12,) joint torques the servos produced on the last physics step [N·m].
+    self_contact:
+        True when two of the robot's own geoms are in contact (a leg and the
+        trunk, two legs, two links of one leg that are not parent and child):
+        contacts no planner here models, which a robot file's collision
+        shapes can make by mistake (a trunk hull the legs rub).
     """
 
     time: float

@@ -29,6 +29,8 @@ _ROWS = (
     ("max_roll_rad", "largest roll", "rad"),
     ("max_pitch_rad", "largest pitch", "rad"),
     ("final_distance_m", "final distance to goal", "m"),
+    ("shin_contacts", "legs touching the terrain above the foot", "ticks"),
+    ("self_contacts", "robot touching itself", "ticks"),
 )
 
 
