@@ -111,7 +111,7 @@ def measure(world: World) -> MeasuredState:
         elif g2 == terrain:
             other, sign = g1, -1.0
         else:
-            self_contact = self_contact or bool(roles.leg[g1] >= -1 and roles.leg[g2] >= -1)
+            self_contact = self_contact or (roles.on_robot(g1) and roles.on_robot(g2))
             continue
         leg = int(roles.leg[other])
         if leg == -1:

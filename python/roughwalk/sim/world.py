@@ -65,6 +65,10 @@ class GeomRoles:
     terrain: int
     trunk: NDArray[np.int64]
 
+    def on_robot(self, geom: int) -> bool:
+        """Whether ``geom`` belongs to the robot (its trunk or a leg), not the world."""
+        return bool(self.leg[geom] >= -1)
+
 
 def _foot_geom_name(robot: Robot, leg: int) -> str:
     described = robot.description.feet[leg]
