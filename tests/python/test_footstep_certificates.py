@@ -9,6 +9,7 @@ re-derived here from the footsteps alone.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
@@ -25,6 +26,9 @@ TERRAINS = (
     "round_rocks:seed=7,length=0.9,width=0.6,pad_start=0.3,pad_end=0.15,max_height=0.05",
     "sloped_rocks:seed=3,length=0.9,width=0.6,pad_start=0.3,pad_end=0.15,max_height=0.05",
 )
+# (terrain, footstep.normal_radius): the foot centres sit along the point
+# normal, and once along the mean slope over the foot's disc.
+CASES = (*((t, 0.0) for t in TERRAINS), (TERRAINS[1], 0.0103))
 START = (0.25, 0.0, 0.0)
 GOAL = (0.6, 0.05)
 
@@ -100,6 +104,21 @@ def body_samples(
     return out
 
 
+def brute_disc_normals(terrain: rw.Terrain, xy: np.ndarray, radius: float) -> np.ndarray:
+    """Normals of the mean bilinear gradient over the points within ``radius`` of each
+    row of ``xy``, on a grid of spacing radius / ceil(radius / min(dx, dy))."""
+    n = math.ceil(radius / min(terrain.dx, terrain.dy))
+    i, j = np.mgrid[-n : n + 1, -n : n + 1]
+    off = np.column_stack([i.ravel(), j.ravel()]) * (radius / n)
+    off = off[np.sum(off**2, axis=1) <= radius**2 + 1e-15]
+    out = []
+    for p in xy:
+        _, g = terrain.height_and_gradient(p + off)
+        gx, gy = g.mean(axis=0)
+        out.append(np.array([-gx, -gy, 1.0]) / math.sqrt(gx * gx + gy * gy + 1.0))
+    return np.array(out)
+
+
 def cross2(u: np.ndarray, v: np.ndarray) -> float:
     return float(u[0] * v[1] - u[1] * v[0])
 
@@ -114,9 +133,13 @@ def triangle_margin(p: np.ndarray, tri: np.ndarray) -> float:
     return out
 
 
-@pytest.fixture(scope="module", params=TERRAINS)
+@pytest.fixture(scope="module", params=CASES, ids=lambda c: f"{c[0].split(':')[0]}-r{c[1]}")
 def planned(request: pytest.FixtureRequest, littledog: rw.Robot) -> tuple[FootstepPlanner, Any]:
-    planner = FootstepPlanner(littledog, rw.load_terrain(request.param))
+    spec, normal_radius = request.param
+    config = dataclasses.replace(
+        rw.planning.FootstepConfig.for_robot(littledog), normal_radius=normal_radius
+    )
+    planner = FootstepPlanner(littledog, rw.load_terrain(spec), config)
     plan = planner.plan(START, GOAL, time_limit=None, expansions=400)
     assert plan.status == "solved", plan.reason
     return planner, plan
@@ -147,8 +170,11 @@ def test_every_certificate_holds_its_stance_in_mujoco(
         data.qpos[:] = littledog.qpos(cert.q, cert.base_pos, cert.base_quat)
         mujoco.mj_kinematics(model, data)
         mujoco.mj_comPos(model, data)
-        # Foot centres on their footholds: the contact point plus the radius along the normal.
+        # Foot centres on their footholds: the contact point plus the radius
+        # along the normal (the mean slope's over the disc with normal_radius).
         normals = terrain.normal(stance[:, :2])
+        if config.normal_radius > 0:
+            normals = brute_disc_normals(terrain, stance[:, :2], config.normal_radius)
         for i, g in foot_geoms.items():
             target = stance[i] + radius[i] * normals[i]
             assert np.linalg.norm(data.geom_xpos[g] - target) < 1e-3, (k, LEGS[i])

@@ -74,6 +74,27 @@ def test_a_contact_on_a_ridge_flank_rests_the_foot_on_the_ridge(littledog: rw.Ro
     np.testing.assert_allclose(seq.initial_stance[:, 2], r, atol=1e-9)
 
 
+def test_disc_centre_sits_along_the_mean_slope_of_the_foots_disc(littledog: rw.Robot) -> None:
+    """On the ridge's flank the disc's mean slope leans 2° against the point normal's 79°:
+    the centre along it sinks 2.5 mm, half the flank's height it stands below the top
+    (6 mm along the point normal); only "resting" clears the ridge."""
+    terrain = _ridge_terrain()
+    r = littledog.foot_radius
+    contact = (0.1985, 0.0)
+    wb = WholeBody(littledog)
+    z = float(terrain.height(np.array([contact]))[0])
+    seq = StepSequence.from_plan(
+        _plan(littledog, contact, z), wb, terrain=terrain, foot_centre="disc"
+    )
+    n = terrain.disc_normal(np.array([contact]), r)[0]
+    assert n[2] > np.cos(np.radians(30.0)) > terrain.normal(np.array([contact]))[0][2]
+    np.testing.assert_allclose(seq.steps[0].target, [*contact, z] + r * n, atol=1e-12)
+    normal = StepSequence.from_plan(_plan(littledog, contact, z), wb, terrain=terrain)
+    sinks = _sinks(terrain, seq.steps[0].target, r)
+    assert sinks < 0.003 < 0.005 < _sinks(terrain, normal.steps[0].target, r)
+    np.testing.assert_allclose(seq.initial_stance[:, 2], r, atol=1e-9)
+
+
 def test_resting_centres_on_flat_and_a_step() -> None:
     terrain = _ridge_terrain()
     r = 0.0103

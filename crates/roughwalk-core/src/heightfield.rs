@@ -243,6 +243,36 @@ impl HeightField {
         [-gx / n, -gy / n, 1.0 / n]
     }
 
+    /// Unit upward normal of the mean slope over the disc of `radius` [m]
+    /// around (x, y): the bilinear gradient averaged over the points of a
+    /// square grid of spacing r / ⌈r / min(dx, dy)⌉ within the disc, the
+    /// mean gradient the foothold slope checks judge a foot's disc by.
+    /// `radius` ≤ 0 gives [`normal`](Self::normal) at the point.
+    pub fn disc_normal(&self, x: f64, y: f64, radius: f64) -> [f64; 3] {
+        if radius <= 0.0 {
+            return self.normal(x, y, Interpolation::Bilinear);
+        }
+        let n = ((radius / self.dx.min(self.dy)).ceil() as i64).max(1);
+        let step = radius / n as f64;
+        let (mut gx, mut gy, mut count) = (0.0, 0.0, 0usize);
+        for i in -n..=n {
+            for j in -n..=n {
+                let (ox, oy) = (i as f64 * step, j as f64 * step);
+                if ox * ox + oy * oy > radius * radius + 1e-15 {
+                    continue;
+                }
+                let (_, a, b) = self.height_and_gradient(x + ox, y + oy, Interpolation::Bilinear);
+                gx += a;
+                gy += b;
+                count += 1;
+            }
+        }
+        gx /= count as f64;
+        gy /= count as f64;
+        let norm = (gx * gx + gy * gy + 1.0).sqrt();
+        [-gx / norm, -gy / norm, 1.0 / norm]
+    }
+
     /// Minimum and maximum stored height [m].
     pub fn height_range(&self) -> (f64, f64) {
         self.heights
@@ -301,6 +331,62 @@ mod tests {
                 assert!((gx - 0.3).abs() < 1e-12 && (gy + 0.2).abs() < 1e-12);
             }
         }
+    }
+
+    #[test]
+    fn disc_normal_is_the_plane_normal_on_a_plane_and_the_point_normal_at_zero_radius() {
+        let hf = plane(0.3, -0.2, 0.1);
+        for &(x, y) in &[(0.0, 0.3), (0.123, 0.41)] {
+            let n = hf.normal(x, y, Interpolation::Bilinear);
+            for r in [0.0, 0.01, 0.07] {
+                let d = hf.disc_normal(x, y, r);
+                assert!((0..3).all(|k| (d[k] - n[k]).abs() < 1e-12), "{d:?} {n:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn disc_normal_averages_a_ridge_that_the_point_normal_sees_one_side_of() {
+        // A roof h = 0.2 - |x| on a 1 cm grid: 1 mm off the ridge the point
+        // normal leans 45°, the mean over a 3 cm disc 14°.
+        let (nx, ny) = (41, 21);
+        let mut h = Vec::new();
+        for ix in 0..nx {
+            for _ in 0..ny {
+                h.push(0.2 - (-0.2 + ix as f64 * 0.01_f64).abs());
+            }
+        }
+        let hf = HeightField::new(-0.2, -0.1, 0.01, 0.01, nx, ny, h, None).unwrap();
+        let point = hf.normal(0.001, 0.0, Interpolation::Bilinear);
+        assert!((point[2] - 0.5_f64.sqrt()).abs() < 1e-12);
+        let disc = hf.disc_normal(0.001, 0.0, 0.03);
+        // Mean gradient over the 29 grid points within 3 cm: the column at
+        // x = 0.001 - 0.01·k, k ∈ {0, 1, 2, 3}, lies right of the ridge for
+        // k = 0 only; brute force over the same points.
+        let (mut gx, mut count) = (0.0_f64, 0.0_f64);
+        for i in -3i32..=3 {
+            for j in -3i32..=3 {
+                if i * i + j * j <= 9 {
+                    gx += if 0.001 + 0.01 * f64::from(i) > 0.0 {
+                        -1.0
+                    } else {
+                        1.0
+                    };
+                    count += 1.0;
+                }
+            }
+        }
+        gx /= count;
+        let want = [
+            -gx / (gx * gx + 1.0).sqrt(),
+            0.0,
+            1.0 / (gx * gx + 1.0).sqrt(),
+        ];
+        assert!(
+            (0..3).all(|k| (disc[k] - want[k]).abs() < 1e-12),
+            "{disc:?} {want:?}"
+        );
+        assert!(disc[2] > 0.95); // 14° against the point normal's 45°
     }
 
     #[test]

@@ -156,6 +156,7 @@ pub fn test_config() -> FootstepConfig {
     }
     FootstepConfig {
         resolution: 0.005,
+        normal_radius: 0.0,
         actions,
         walking_order: [2, 0, 3, 1],
         local_search_radius: 0.01,

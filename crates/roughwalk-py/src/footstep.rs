@@ -91,6 +91,7 @@ fn parse_config(d: &Bound<'_, PyDict>) -> PyResult<FootstepConfig> {
     let heuristic: String = item(d, "heuristic")?;
     let config = FootstepConfig {
         resolution: item(d, "resolution")?,
+        normal_radius: item(d, "normal_radius")?,
         actions: actions.into_iter().map(|(a, b, c)| [a, b, c]).collect(),
         walking_order: item(d, "walking_order")?,
         local_search_radius: item(d, "local_search_radius")?,

@@ -99,6 +99,33 @@ impl PyHeightField {
         Ok((PyArray1::from_vec(py, h), g))
     }
 
+    /// Unit upward normals (N, 3) of the mean slope over the disc of
+    /// `radius` [m] around each (N, 2) point (`HeightField::disc_normal`).
+    fn disc_normal<'py>(
+        &self,
+        py: Python<'py>,
+        xy: PyReadonlyArray2<'py, f64>,
+        radius: f64,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        if !(radius.is_finite() && radius >= 0.0) {
+            return Err(crate::errors::to_py(
+                roughwalk_core::CoreError::InvalidArgument(format!(
+                    "radius must be finite and >= 0, got {radius}"
+                )),
+            ));
+        }
+        let pts = xy_rows(&xy)?;
+        let n: Vec<Vec<f64>> = py.detach(|| {
+            pts.iter()
+                .map(|&(x, y)| self.inner.disc_normal(x, y, radius).to_vec())
+                .collect()
+        });
+        if n.is_empty() {
+            return Ok(PyArray2::zeros(py, [0, 3], false));
+        }
+        PyArray2::from_vec2(py, &n).map_err(Into::into)
+    }
+
     /// Whether each (N, 2) point lies over a fully measured grid cell.
     fn is_known<'py>(
         &self,

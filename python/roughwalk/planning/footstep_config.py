@@ -200,6 +200,14 @@ class FootstepConfig:
     resolution:
         Foothold lattice spacing [m] (L/40 [5 mm], the paper's grid). Finer
         finds better footholds but multiplies the states.
+    normal_radius:
+        Radius [m] of the disc over which a foothold's normal is the mean
+        slope (:meth:`~roughwalk.terrain.terrain.Terrain.disc_normal`): the
+        foot centre the pose certificates place sits the foot radius along
+        it. 0 (default) takes the bilinear normal at the contact point,
+        over one grid cell, which on a scanned rock can lean 20° more than
+        the disc the slope checks judge; with the foot radius, the centre
+        is the one ``trajectory.foot_centre="disc"`` aims at.
     actions:
         Footstep displacements (dx, dy, dθ) [m, m, rad] of the moving leg in
         the heading frame, added to its nominal place around the feet's
@@ -373,6 +381,7 @@ class FootstepConfig:
     """
 
     resolution: float = 0.005
+    normal_radius: float = 0.0
     actions: tuple[tuple[float, float, float], ...] = ()
     walking_order: tuple[str, str, str, str] = WALKING_ORDERS["crawl"]
     local_search_radius: float = 0.01
@@ -405,6 +414,7 @@ class FootstepConfig:
 
     def __post_init__(self) -> None:
         _check("resolution", self.resolution, strict=True)
+        _check("normal_radius", self.normal_radius)
         if not self.actions:
             raise ConfigError(
                 "footstep.actions must hold at least one (dx, dy, dtheta); "

@@ -226,6 +226,18 @@ class Terrain:
         n = np.column_stack([-g[:, 0], -g[:, 1], np.ones(len(g))])
         return n / np.linalg.norm(n, axis=1, keepdims=True)
 
+    def disc_normal(self, xy: ArrayLike, radius: float) -> NDArray[np.float64]:
+        """Unit upward normals (N, 3) of the mean slope over the disc of ``radius`` [m] at ``xy``.
+
+        The bilinear gradient averaged over the points of a square grid of
+        spacing r / ⌈r / min(dx, dy)⌉ within the disc: the mean slope the
+        foothold checks judge a foot's disc by
+        (:func:`~roughwalk.planning.foothold_safety.steep_footholds`), and
+        the footstep planner's foot-centre normal with
+        ``footstep.normal_radius``. ``radius`` 0 gives :meth:`normal`.
+        """
+        return np.asarray(self._hf.disc_normal(self._xy(xy), float(radius)), dtype=float)
+
     def slope(
         self, xy: ArrayLike, interpolation: Interpolation = "bilinear"
     ) -> NDArray[np.float64]:

@@ -911,7 +911,11 @@ class TrajectoryConfig:
         How a planned contact point becomes the foot-sphere centre the
         swing aims at and the stance holds: "normal", the contact plus the
         foot radius along the terrain's normal at that one point (the
-        planner's own centre); "resting", where the sphere rests lowered
+        planner's own centre); "disc", the contact plus the foot radius
+        along the normal of the mean slope over the foot's disc
+        (:meth:`~roughwalk.terrain.terrain.Terrain.disc_normal`; the
+        planner's centre with ``footstep.normal_radius`` the foot radius);
+        "resting", where the sphere rests lowered
         straight onto the contact's (x, y), over the whole foot's disc as
         the planner's slope and rim checks judge it
         (:func:`~roughwalk.trajectories.step_sequence._foot_centres`).
@@ -935,9 +939,10 @@ class TrajectoryConfig:
 
     def __post_init__(self) -> None:
         _check_positive(self, ("control_rate_hz", "sdf_resolution"), "trajectory")
-        if self.foot_centre not in ("normal", "resting"):
+        if self.foot_centre not in ("normal", "disc", "resting"):
             raise ConfigError(
-                f"trajectory.foot_centre must be 'normal' or 'resting', got {self.foot_centre!r}"
+                "trajectory.foot_centre must be 'normal', 'disc' or 'resting', "
+                f"got {self.foot_centre!r}"
             )
         for name, kind in (
             ("timing", TimingConfig),

@@ -48,7 +48,7 @@ if TYPE_CHECKING:
 
 __all__ = ["FOOT_CENTRES", "StepSpec", "StepSequence", "plan_fields"]
 
-FOOT_CENTRES = ("normal", "resting")
+FOOT_CENTRES = ("normal", "disc", "resting")
 """How a contact point becomes a foot-sphere centre (:func:`_foot_centres`)."""
 
 
@@ -154,8 +154,11 @@ def _foot_centres(
 
     ``foot_centre`` "normal": contact plus radius along the normal; or the
     certificate's own foot centre where its joint angles put the foot
-    within 1 cm of that. "resting": the sphere lowered straight onto the
-    contact's (x, y) rests there (needs ``terrain``; without it, "normal").
+    within 1 cm of that. "disc": the same along the normal of the mean
+    slope over the foot's disc (:meth:`Terrain.disc_normal`), as the
+    planner places it with ``footstep.normal_radius`` the foot radius.
+    "resting": the sphere lowered straight onto the contact's (x, y)
+    rests there (needs ``terrain``; without it, "normal").
 
     The normal is the bilinear one at the contact point, over one grid
     cell (1.2 mm on the LittleDog boards), while the planner judges a
@@ -174,10 +177,15 @@ def _foot_centres(
         for k, leg in enumerate(legs):
             out[leg] = resting_centres(terrain, xy[k : k + 1], float(radius[k]))[0]
         return out
-    normals = (
-        terrain.normal(xy) if terrain is not None else np.tile([0.0, 0.0, 1.0], (len(legs), 1))
-    )
     radius = np.array([wb.robot.leg_descriptions[i].foot_radius for i in legs])
+    if terrain is None:
+        normals = np.tile([0.0, 0.0, 1.0], (len(legs), 1))
+    elif foot_centre == "disc":
+        normals = np.vstack(
+            [terrain.disc_normal(xy[k : k + 1], float(radius[k])) for k in range(len(legs))]
+        )
+    else:
+        normals = terrain.normal(xy)
     out[legs] = out[legs] + radius[:, None] * normals
     q = None if certificate is None else _get(certificate, "q")
     if q is not None:

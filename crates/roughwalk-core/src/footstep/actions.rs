@@ -134,7 +134,7 @@ mod tests {
         let costs: Vec<f64> = (0..nx * ny)
             .map(|k| 1.0 + 2.0 * (((k * 7919) % 1013) as f64 / 1013.0))
             .collect();
-        let map = CostMap::new(&hf, &costs, &costs, 0.005).unwrap();
+        let map = CostMap::new(&hf, &costs, &costs, 0.005, 0.0).unwrap();
         let search = LocalSearch::new(0.012, 0.005, 0.3);
         assert_eq!(search.len(), 21);
         for target in [[20i16, 20i16], [1, 1], [0, 40], [39, 3]] {

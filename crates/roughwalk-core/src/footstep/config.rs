@@ -99,6 +99,11 @@ pub struct CertificateConfig {
 pub struct FootstepConfig {
     /// Foothold lattice spacing [m].
     pub resolution: f64,
+    /// Radius [m] of the disc over which a foothold's normal is the mean
+    /// slope ([`HeightField::disc_normal`](crate::heightfield::HeightField::disc_normal)),
+    /// the normal along which the foot centre sits; 0 takes the bilinear
+    /// normal at the contact point alone.
+    pub normal_radius: f64,
     /// Footstep displacements (dx, dy, dθ) of the moving leg in the heading
     /// frame [m, m, rad] (12–25 of them in the paper).
     pub actions: Vec<[f64; 3]>,
@@ -221,6 +226,7 @@ impl FootstepConfig {
     /// Checks every field; the message names the bad one and what is valid.
     pub fn validate(&self) -> CoreResult<()> {
         positive("resolution", self.resolution)?;
+        non_negative("normal_radius", self.normal_radius)?;
         if self.actions.is_empty() {
             return Err(CoreError::Planning(
                 "footstep config: actions must hold at least one (dx, dy, dtheta)".into(),

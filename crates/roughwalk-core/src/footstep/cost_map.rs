@@ -36,13 +36,16 @@ impl CostMap {
     /// height field.
     ///
     /// A cell is a foothold when the height field's cell under it is known
-    /// and the nearest grid point's cost is finite and > 0. Heights and
-    /// normals are bilinear, as `Terrain.height` and `Terrain.normal`.
+    /// and the nearest grid point's cost is finite and > 0. Heights are
+    /// bilinear, as `Terrain.height`; normals are the mean slope's over the
+    /// disc of `normal_radius` [m] ([`HeightField::disc_normal`]), or with
+    /// 0 the bilinear normal at the point, as `Terrain.normal`.
     pub fn new(
         heightfield: &HeightField,
         cost_front: &[f64],
         cost_hind: &[f64],
         resolution: f64,
+        normal_radius: f64,
     ) -> CoreResult<Self> {
         let n = heightfield.nx * heightfield.ny;
         for (name, grid) in [("front", cost_front), ("hind", cost_hind)] {
@@ -94,7 +97,7 @@ impl CostMap {
                 min_cost = min_cost.min(c[0]).min(c[1]);
                 cost.push(c);
                 z.push(heightfield.height(x, y, Interpolation::Bilinear));
-                normal.push(heightfield.normal(x, y, Interpolation::Bilinear));
+                normal.push(heightfield.disc_normal(x, y, normal_radius));
             }
         }
         Ok(Self {
@@ -182,7 +185,7 @@ mod tests {
         front[10 * ny + 5] = 3.0;
         let mut hind = vec![2.0; nx * ny];
         hind[20 * ny + 10] = f64::INFINITY;
-        let map = CostMap::new(&hf, &front, &hind, 0.005).unwrap();
+        let map = CostMap::new(&hf, &front, &hind, 0.005, 0.0).unwrap();
         assert_eq!((map.lattice().nx, map.lattice().ny), (41, 21));
         assert_eq!(map.cost([20, 10], 0), 3.0);
         assert_eq!(map.cost([20, 10], 2), 2.0);
@@ -200,9 +203,9 @@ mod tests {
         let n = 1.0 / (1.0f64 + 0.01).sqrt();
         assert!((f[0] - (0.15 - 0.01 * 0.1 * n)).abs() < 1e-12);
         assert!((f[2] - (c[2] + 0.01 * n)).abs() < 1e-12);
-        assert!(CostMap::new(&hf, &front[1..], &hind, 0.005).is_err());
+        assert!(CostMap::new(&hf, &front[1..], &hind, 0.005, 0.0).is_err());
         let mut zero = front.clone();
         zero[3] = 0.0;
-        assert!(CostMap::new(&hf, &zero, &hind, 0.005).is_err());
+        assert!(CostMap::new(&hf, &zero, &hind, 0.005, 0.0).is_err());
     }
 }

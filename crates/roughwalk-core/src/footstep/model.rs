@@ -173,7 +173,13 @@ impl FootstepModel {
         // values only, so clearances on it are never larger and the march
         // takes fewer samples (AD: 24 % fewer clearance instructions).
         let sdf = sdf.lipschitz_envelope();
-        let map = CostMap::new(heightfield, cost_front, cost_hind, config.resolution)?;
+        let map = CostMap::new(
+            heightfield,
+            cost_front,
+            cost_hind,
+            config.resolution,
+            config.normal_radius,
+        )?;
         if map.foothold_count() == 0 {
             return Err(CoreError::Planning(
                 "the terrain has no foothold: every cost is +inf/NaN or every cell unknown".into(),
