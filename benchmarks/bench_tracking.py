@@ -338,7 +338,9 @@ def job_config(job: Job) -> Any:
     if job.trajopt:
         config = override(config, dict(job.trajopt))
     if job.add_constraints:
-        config = replace(config, constraints=config.constraints + job.add_constraints)
+        # Only those the set lacks: a model's recorded set may hold them already.
+        new = tuple(c for c in dict.fromkeys(job.add_constraints) if c not in config.constraints)
+        config = replace(config, constraints=config.constraints + new)
     if job.costs:
         from roughwalk.learning.model_costs import cost_changes
 

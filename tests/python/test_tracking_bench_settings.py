@@ -40,6 +40,15 @@ def test_repeated_flags_add_up_and_a_list_keeps_its_commas() -> None:
     assert config.dt_dynamics == 0.04
 
 
+def test_added_constraints_are_appended_once() -> None:
+    bench = load_benchmark("bench_tracking")
+    base = bench.job_config(_job(bench)).constraints
+    assert "joint_torques" not in base and base
+    added = ("joint_torques", base[0], "joint_torques")
+    config = bench.job_config(_job(bench, add_constraints=added))
+    assert config.constraints == (*base, "joint_torques")
+
+
 def test_an_unknown_field_names_the_option_the_field_and_the_known_ones() -> None:
     bench = load_benchmark("bench_tracking")
     with pytest.raises(SystemExit, match="--trajopt: unknown config field 'dt_dynamic' .*known:"):
