@@ -1048,6 +1048,18 @@ class ExecutorConfig:
         (``compute_time_scale``) the robot waits for it at the end of the
         current footstep, up to ``reflex.replan_budget_s`` and the rebuild
         (~0.5 s).
+    relax_edge_margin:
+        Where the walk's footstep planner, keeping feet
+        ``footstep.edge_margin`` > 0 beyond their radius from a rim, finds
+        no plan (no start stance it certifies, a re-plan from where the
+        feet stand with nowhere to step), a second planner with the
+        margin 0 plans from the same start
+        (:class:`~roughwalk.sim.footstep_source.PlannerSource`'s
+        ``fallback``; the ``plan`` and ``replan`` events say ``relaxed``).
+        The margin keeps feet off rims they would land on by a
+        touchdown's few millimetres of error, but near rocks it can leave
+        a stance no step out of (figures in
+        :data:`~roughwalk.sim.footstep_source.EXECUTION_FOOTHOLD_SAFETY`).
     """
 
     compute_time_scale: float = 1.0
@@ -1057,6 +1069,7 @@ class ExecutorConfig:
     start_snap_m: float = 0.015
     start_max_slope: float = 0.5 * math.pi
     refuse_colliding_m: float = 0.03
+    relax_edge_margin: bool = True
 
     def __post_init__(self) -> None:
         _nonnegative(

@@ -293,7 +293,14 @@ class Executor:
             goal_xy,
             cfg.executor.initial_plan_s,
         )
-        log.event(0.0, "plan", status=attempt.status, wall_s=wall, source=self.source.name)
+        log.event(
+            0.0,
+            "plan",
+            status=attempt.status,
+            wall_s=wall,
+            source=self.source.name,
+            relaxed=attempt.relaxed,
+        )
         first = self._next_step(plan)[0] if plan is not None else None
         if plan is None or first is None:
             if plan is None:
@@ -1114,6 +1121,7 @@ class Executor:
             charged_s=charged,
             next_leg=LEG_NAMES[next_leg] if next_leg is not None else None,
             start=start_from,
+            relaxed=attempt.relaxed,
             start_clearance_m=attempt.start_clearance_m if plan is not None else None,
             reason=attempt.reason if plan is None else "",
         )

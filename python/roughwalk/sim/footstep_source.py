@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
@@ -96,6 +96,8 @@ class PlanAttempt:
     (the footstep planner; None otherwise): below the planner's
     ``certificate.clearance`` it says the start was certified only with the
     relaxed ``certificate.start_clearance`` from the measured trunk.
+    ``relaxed``: the plan is the source's second planner's, with its
+    ``fallback`` settings (:class:`PlannerSource`).
     """
 
     plan: Any
@@ -103,6 +105,7 @@ class PlanAttempt:
     reason: str
     wall_s: float
     start_clearance_m: float | None = None
+    relaxed: bool = False
 
     @property
     def ok(self) -> bool:
@@ -257,6 +260,12 @@ class PlannerSource:
         Steepest slope [rad] a start foot may stand on, where the footstep
         settings allow steeper footholds
         (:attr:`~roughwalk.sim.config.ExecutorConfig.start_max_slope`).
+    fallback:
+        Footstep settings (a :class:`~roughwalk.planning.footstep_config.FootstepConfig`)
+        of a second planner, on the same terrain cost and signed distance
+        field, that plans where this one finds no plan: from a start or a
+        re-plan's feet (it is built the first time it is needed). None: no
+        second planner (:attr:`~roughwalk.sim.config.ExecutorConfig.relax_edge_margin`).
     options:
         Passed on to :class:`~roughwalk.planning.footstep_planner.FootstepPlanner`.
     """
@@ -270,6 +279,7 @@ class PlannerSource:
         expansions: int | None = None,
         start_snap_m: float = ExecutorConfig.start_snap_m,
         start_max_slope: float = ExecutorConfig.start_max_slope,
+        fallback: Any = None,
         **options: Any,
     ) -> None:
         from roughwalk.planning.footstep_planner import FootstepPlanner
@@ -283,9 +293,49 @@ class PlannerSource:
         self.planner = FootstepPlanner(robot, terrain, **options)
         self._refused: list[tuple[int, float, float, float]] = []
         self._refusing_planner: Any = None
+        self.fallback = fallback
+        self._fallback_source: PlannerSource | None = None
+
+    def _second(self) -> PlannerSource | None:
+        """The planner of ``fallback``'s settings, built on first use (None without them)."""
+        if self.fallback is None:
+            return None
+        if self._fallback_source is None:
+            self._fallback_source = PlannerSource(
+                self.robot,
+                self.terrain,
+                self.expansions,
+                self.start_snap_m,
+                self.start_max_slope,
+                config=self.fallback,
+                cost=self.planner.cost,
+                sdf=self.planner.sdf,
+            )
+        return self._fallback_source
 
     def plan(self, start: PlanStart, goal: NDArray[np.float64], time_limit: float) -> PlanAttempt:
-        """Plan within ``time_limit`` [s]; the best plan found by then is returned."""
+        """Plan within ``time_limit`` [s]; the best plan found by then is returned.
+
+        Where none comes and there are ``fallback`` settings, their planner
+        plans from the same start (keeping every foothold refused so far)
+        within what is left of ``time_limit``; its attempt's ``wall_s``
+        counts both.
+        """
+        attempt = self._plan_once(start, goal, time_limit)
+        second = self._second()
+        if attempt.ok or second is None:
+            return attempt
+        refused = replace(start, refused=tuple(self._refused)) if start.feet is not None else start
+        left = max(time_limit - attempt.wall_s, 0.0) if self.expansions is None else time_limit
+        again = second._plan_once(refused, goal, left)
+        if not again.ok:
+            return replace(attempt, wall_s=attempt.wall_s + again.wall_s)
+        return replace(again, wall_s=attempt.wall_s + again.wall_s, relaxed=True)
+
+    def _plan_once(
+        self, start: PlanStart, goal: NDArray[np.float64], time_limit: float
+    ) -> PlanAttempt:
+        """:meth:`plan` with this planner alone."""
         began = time.perf_counter()
         g = np.asarray(goal, dtype=float)[:2]
         if start.pose is not None:
@@ -349,7 +399,12 @@ class PlannerSource:
         result = planner.replan(feet, leg, goal=g, time_limit=None, expansions=0, trunk=start.trunk)
         # With no search the result carries no certificate; "invalid_input"
         # is what a start stance without one (or a foot on no foothold) gives.
-        return bool(result.status != "invalid_input")
+        if result.status != "invalid_input":
+            return True
+        second = self._second()
+        return second is not None and second.certifies(
+            replace(start, refused=tuple(self._refused)), goal
+        )
 
     def _refusing(self, refused: tuple[tuple[int, float, float, float], ...]) -> Any:
         """The planner, or one that keeps every leg out of the discs ``refused`` has ever named.
@@ -459,6 +514,7 @@ def split_footstep_settings(
 
 EXECUTION_FOOTHOLD_SAFETY: dict[str, Any] = {
     "edge_drop": 0.03,
+    "edge_margin": 0.01,
     "max_foothold_slope": math.radians(45.0),
 }
 """Footstep settings a walk in physics plans with unless told otherwise.

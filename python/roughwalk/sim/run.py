@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -170,6 +170,8 @@ def run(
         "start_max_slope": cfg.executor.start_max_slope,
     }
     options["config"] = planner_config(robot_obj, cfg.executor.longest_step, footstep)
+    if cfg.executor.relax_edge_margin and options["config"].edge_margin > 0:
+        options["fallback"] = replace(options["config"], edge_margin=0.0)
     if isinstance(planner, str):
         if planner == "auto":
             source: FootstepSource = default_source(robot_obj, seen, **options)

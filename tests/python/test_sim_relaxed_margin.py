@@ -1,0 +1,86 @@
+"""A walk keeps feet off rims by a margin, and plans without it where the margin leaves no plan."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from roughwalk.robots import load_robot
+from roughwalk.sim import run
+from roughwalk.sim.footstep_source import PlannerSource, PlanStart, planner_config
+from roughwalk.terrain import Terrain
+
+START = (0.3, 0.0, 0.0)
+GOAL = (0.9, 0.0)
+
+
+def _pitted_band() -> Terrain:
+    """Flat ground crossed at x ∈ (0.42, 0.78) m by 6 mm square pits, 3.5 cm deep, every 3.2 cm.
+
+    Every point of the band lies within 1.84 cm of a pit: with a 1 cm margin
+    beyond LittleDog's 1.03 cm foot radius no foothold is left there, and the
+    band is wider than any step; without it, strips midway between the pits
+    (2.7 mm either side of them, 1.3 cm from the nearest pit) remain.
+    """
+    d = 0.002
+    x = np.arange(0.0, 1.0 + d / 2, d)
+    y = np.arange(-0.4, 0.4 + d / 2, d)
+    gx, gy = np.meshgrid(x, y, indexing="ij")
+    pitch, half = 0.032, 0.003
+    pit = (
+        (gx > 0.42)
+        & (gx < 0.78)
+        & (np.abs((gx + pitch / 2) % pitch - pitch / 2) <= half)
+        & (np.abs((gy + pitch / 2) % pitch - pitch / 2) <= half)
+    )
+    return Terrain(np.where(pit, -0.035, 0.0), 0.0, -0.4, d, d, name="pitted band")
+
+
+@pytest.fixture(scope="module")
+def terrain() -> Terrain:
+    return _pitted_band()
+
+
+def test_the_second_planner_plans_where_the_margin_leaves_no_plan(terrain: Terrain) -> None:
+    robot = load_robot("littledog")
+    walk = planner_config(robot, 0.4, {})
+    assert walk.edge_margin == pytest.approx(0.01)  # a walk's default
+    strict = PlannerSource(robot, terrain, expansions=3000, config=walk)
+    alone = strict.plan(PlanStart(pose=START), np.array(GOAL), 30.0)
+    assert not alone.ok and not alone.relaxed
+    source = PlannerSource(
+        robot, terrain, expansions=3000, config=walk, fallback=replace(walk, edge_margin=0.0)
+    )
+    attempt = source.plan(PlanStart(pose=START), np.array(GOAL), 30.0)
+    assert attempt.ok and attempt.relaxed
+    assert attempt.wall_s >= alone.wall_s * 0.5  # both planners' time counts
+    # Every foothold keeps the foot's radius, if not the margin, from the pits'
+    # grid points (less the 1.4 mm a foothold lies from the grid point it is judged by).
+    pits = np.argwhere(np.asarray(terrain.heights) < -0.01) * terrain.dx + [terrain.x0, terrain.y0]
+    near = []
+    for step in attempt.plan.footsteps:
+        nearest = float(np.min(np.linalg.norm(pits - [step.x, step.y], axis=1)))
+        assert nearest > robot.foot_radius - terrain.dx / np.sqrt(2)
+        near.append(nearest < robot.foot_radius + 0.01)
+    assert any(near)  # and some stand within the margin: the band is crossed
+
+
+def test_a_run_plans_relaxed_by_default_and_says_so(terrain: Terrain) -> None:
+    settings = {"executor.plan_expansions": 3000, "outcome.time_limit_s": 0.2}
+    result = run("littledog", terrain, START, GOAL, planner="planner", **settings)
+    plan = next(e for e in result.log.events if e["kind"] == "plan")
+    assert plan["status"] != "no_solution" and plan["relaxed"] is True
+    assert not result.outcome.reason.startswith("no plan")
+    off = run(
+        "littledog",
+        terrain,
+        START,
+        GOAL,
+        planner="planner",
+        **settings,
+        **{"executor.relax_edge_margin": False},
+    )
+    assert off.outcome.reason.startswith("no plan")
+    assert next(e for e in off.log.events if e["kind"] == "plan")["relaxed"] is False
