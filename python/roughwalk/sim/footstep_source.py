@@ -325,8 +325,10 @@ class PlannerSource:
         second = self._second()
         if attempt.ok or second is None:
             return attempt
+        left = time_limit - attempt.wall_s if self.expansions is None else time_limit
+        if left <= 0.0:
+            return attempt
         refused = replace(start, refused=tuple(self._refused)) if start.feet is not None else start
-        left = max(time_limit - attempt.wall_s, 0.0) if self.expansions is None else time_limit
         again = second._plan_once(refused, goal, left)
         if not again.ok:
             return replace(attempt, wall_s=attempt.wall_s + again.wall_s)
