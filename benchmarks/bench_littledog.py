@@ -178,7 +178,10 @@ def one_run(
     step (:func:`stands_where_put`, from a short run up to ``PROBE_S``, and
     then from the run itself, whose longer planning may start from another
     first pose); if no start holds, the last run made (or a run from the
-    first start) is the result.
+    first start) is the result. The nudges are tried first with
+    ``executor.relax_edge_margin`` "replans", so that the robot stands where
+    the walk's own foothold checks find a plan, and then, if no start
+    held, as ``sets`` say (by default "all": the relaxed checks' plan).
     """
     sim = {k: v for k, v in sets if not k.startswith("trajectory.")}
     traj = {k.removeprefix("trajectory."): v for k, v in sets if k.startswith("trajectory.")}
@@ -189,32 +192,49 @@ def one_run(
     began = time.perf_counter()
     result = None
     tried = 0
-    for dx, dy in START_NUDGES:
-        tried += 1
-        where = (start[0] + dx, start[1] + dy, start[2])
-        # Put the robot down and let it settle: a short run up to the first step.
-        probe = run(
-            "littledog",
-            spec,
-            where,
-            goal,
-            trajectory_config=trajectory_config,
-            **{**sim, "executor.initial_plan_s": probe_plan_s, "outcome.time_limit_s": PROBE_S},
-        )
-        if not stands_where_put(probe):
-            continue
-        result = run(
-            "littledog",
-            spec,
-            where,
-            goal,
-            disturbances=disturbances,
-            trajectory_config=trajectory_config,
-            **{"executor.initial_plan_s": plan_time, **sim},
-        )
-        # The run's longer planning can start from another first pose than
-        # the probe's, which may not hold either: then re-place the robot.
-        if stands_where_put(result):
+    # The robot is put where the walk's own foothold checks find a plan
+    # (a first plan without the relaxed edge margin; re-plans may relax it),
+    # and only where no start does, where the relaxed checks find one.
+    passes = (
+        [{**sim, "executor.relax_edge_margin": "replans"}, sim]
+        if "executor.relax_edge_margin" not in sim
+        else [sim]
+    )
+    held = False
+    for settings in passes:
+        for dx, dy in START_NUDGES:
+            tried += 1
+            where = (start[0] + dx, start[1] + dy, start[2])
+            # Put the robot down and let it settle: a short run up to the first step.
+            probe = run(
+                "littledog",
+                spec,
+                where,
+                goal,
+                trajectory_config=trajectory_config,
+                **{
+                    **settings,
+                    "executor.initial_plan_s": probe_plan_s,
+                    "outcome.time_limit_s": PROBE_S,
+                },
+            )
+            if not stands_where_put(probe):
+                continue
+            result = run(
+                "littledog",
+                spec,
+                where,
+                goal,
+                disturbances=disturbances,
+                trajectory_config=trajectory_config,
+                **{"executor.initial_plan_s": plan_time, **settings},
+            )
+            # The run's longer planning can start from another first pose than
+            # the probe's, which may not hold either: then re-place the robot.
+            held = stands_where_put(result)
+            if held:
+                break
+        if held:
             break
     if result is None:
         dx, dy = START_NUDGES[0]

@@ -7,8 +7,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from roughwalk.errors import ConfigError
 from roughwalk.robots import load_robot
 from roughwalk.sim import run
+from roughwalk.sim.config import ExecutorConfig, SimConfig
 from roughwalk.sim.footstep_source import PlannerSource, PlanStart, planner_config
 from roughwalk.terrain import Terrain
 
@@ -73,14 +75,45 @@ def test_a_run_plans_relaxed_by_default_and_says_so(terrain: Terrain) -> None:
     plan = next(e for e in result.log.events if e["kind"] == "plan")
     assert plan["status"] != "no_solution" and plan["relaxed"] is True
     assert not result.outcome.reason.startswith("no plan")
-    off = run(
-        "littledog",
-        terrain,
-        START,
-        GOAL,
-        planner="planner",
-        **settings,
-        **{"executor.relax_edge_margin": False},
-    )
-    assert off.outcome.reason.startswith("no plan")
-    assert next(e for e in off.log.events if e["kind"] == "plan")["relaxed"] is False
+    for relax in ("replans", "none"):
+        off = run(
+            "littledog",
+            terrain,
+            START,
+            GOAL,
+            planner="planner",
+            **settings,
+            **{"executor.relax_edge_margin": relax},
+        )
+        assert off.outcome.reason.startswith("no plan")
+        assert next(e for e in off.log.events if e["kind"] == "plan")["relaxed"] is False
+
+
+def test_re_plans_relax_the_margin_unless_told_none(terrain: Terrain) -> None:
+    """From feet standing in the band, only the second planner has a step (and only
+    with ``relax_edge_margin`` other than "none")."""
+    robot = load_robot("littledog")
+    walk = planner_config(robot, 0.4, {})
+    feet = np.asarray(robot.nominal_stance.feet, dtype=float).copy()
+    feet[:, 0] += 0.45 - feet[:, 0].mean()
+    feet[:, 2] = robot.foot_radius
+    start = PlanStart(feet=feet, next_leg=2)
+    relaxed = replace(walk, edge_margin=0.0)
+    for from_pose in (True, False):
+        source = PlannerSource(
+            robot,
+            terrain,
+            expansions=3000,
+            config=walk,
+            fallback=relaxed,
+            fallback_from_pose=from_pose,
+        )
+        attempt = source.plan(start, np.array(GOAL), 30.0)
+        assert attempt.ok and attempt.relaxed
+    alone = PlannerSource(robot, terrain, expansions=3000, config=walk)
+    assert not alone.plan(start, np.array(GOAL), 30.0).ok
+
+
+def test_relax_edge_margin_names_its_values() -> None:
+    with pytest.raises(ConfigError, match="relax_edge_margin.*all, replans, none"):
+        SimConfig(executor=ExecutorConfig(relax_edge_margin="sometimes"))

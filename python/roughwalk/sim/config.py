@@ -961,6 +961,10 @@ class OutcomeConfig:
         )
 
 
+RELAX_EDGE_MARGIN = ("all", "replans", "none")
+"""Values of :attr:`ExecutorConfig.relax_edge_margin`."""
+
+
 @dataclass(frozen=True)
 class ExecutorConfig:
     """The execution pipeline (Zucker 2011, §6).
@@ -1051,11 +1055,14 @@ class ExecutorConfig:
     relax_edge_margin:
         Where the walk's footstep planner, keeping feet
         ``footstep.edge_margin`` > 0 beyond their radius from a rim, finds
-        no plan (no start stance it certifies, a re-plan from where the
-        feet stand with nowhere to step), a second planner with the
-        margin 0 plans from the same start
-        (:class:`~roughwalk.sim.footstep_source.PlannerSource`'s
-        ``fallback``; the ``plan`` and ``replan`` events say ``relaxed``).
+        no plan, a second planner with the margin 0 plans from the same
+        start (:class:`~roughwalk.sim.footstep_source.PlannerSource`'s
+        ``fallback``; the ``plan`` and ``replan`` events say ``relaxed``):
+        "all", for the first plan (no start stance it certifies) and for
+        re-plans (from where the feet stand, nowhere to step); "replans",
+        for re-plans only, where a run's start, like a trial's, is put
+        where the walk's own checks find a plan (``roughwalk bench
+        littledog`` tries its start nudges so first); "none".
         The margin keeps feet off rims they would land on by a
         touchdown's few millimetres of error, but near rocks it can leave
         a stance no step out of (figures in
@@ -1069,7 +1076,7 @@ class ExecutorConfig:
     start_snap_m: float = 0.015
     start_max_slope: float = 0.5 * math.pi
     refuse_colliding_m: float = 0.03
-    relax_edge_margin: bool = True
+    relax_edge_margin: str = "all"
 
     def __post_init__(self) -> None:
         _nonnegative(
@@ -1085,6 +1092,11 @@ class ExecutorConfig:
             "executor",
         )
         _positive(self, ("initial_plan_s",), "executor")
+        if self.relax_edge_margin not in RELAX_EDGE_MARGIN:
+            raise ConfigError(
+                f"executor.relax_edge_margin must be one of {', '.join(RELAX_EDGE_MARGIN)}, "
+                f"got {self.relax_edge_margin!r}"
+            )
 
 
 @dataclass(frozen=True)

@@ -266,6 +266,9 @@ class PlannerSource:
         field, that plans where this one finds no plan: from a start or a
         re-plan's feet (it is built the first time it is needed). None: no
         second planner (:attr:`~roughwalk.sim.config.ExecutorConfig.relax_edge_margin`).
+    fallback_from_pose:
+        Whether the second planner also plans from a start pose (the first
+        plan), or only from the feet where they stand (re-plans).
     options:
         Passed on to :class:`~roughwalk.planning.footstep_planner.FootstepPlanner`.
     """
@@ -280,6 +283,7 @@ class PlannerSource:
         start_snap_m: float = ExecutorConfig.start_snap_m,
         start_max_slope: float = ExecutorConfig.start_max_slope,
         fallback: Any = None,
+        fallback_from_pose: bool = True,
         **options: Any,
     ) -> None:
         from roughwalk.planning.footstep_planner import FootstepPlanner
@@ -294,6 +298,7 @@ class PlannerSource:
         self._refused: list[tuple[int, float, float, float]] = []
         self._refusing_planner: Any = None
         self.fallback = fallback
+        self.fallback_from_pose = fallback_from_pose
         self._fallback_source: PlannerSource | None = None
 
     def _second(self) -> PlannerSource | None:
@@ -317,13 +322,14 @@ class PlannerSource:
         """Plan within ``time_limit`` [s]; the best plan found by then is returned.
 
         Where none comes and there are ``fallback`` settings, their planner
-        plans from the same start (keeping every foothold refused so far)
+        plans from the same start (from a pose only with
+        ``fallback_from_pose``), keeping every foothold refused so far,
         within what is left of ``time_limit``; its attempt's ``wall_s``
         counts both.
         """
         attempt = self._plan_once(start, goal, time_limit)
         second = self._second()
-        if attempt.ok or second is None:
+        if attempt.ok or second is None or (start.pose is not None and not self.fallback_from_pose):
             return attempt
         left = time_limit - attempt.wall_s if self.expansions is None else time_limit
         if left <= 0.0:

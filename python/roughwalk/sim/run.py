@@ -170,8 +170,10 @@ def run(
         "start_max_slope": cfg.executor.start_max_slope,
     }
     options["config"] = planner_config(robot_obj, cfg.executor.longest_step, footstep)
-    if cfg.executor.relax_edge_margin and options["config"].edge_margin > 0:
+    relax = cfg.executor.relax_edge_margin
+    if relax != "none" and options["config"].edge_margin > 0:
         options["fallback"] = replace(options["config"], edge_margin=0.0)
+        options["fallback_from_pose"] = relax == "all"
     if isinstance(planner, str):
         if planner == "auto":
             source: FootstepSource = default_source(robot_obj, seen, **options)
