@@ -181,7 +181,8 @@ def one_run(
     first start) is the result. The nudges are tried first with
     ``executor.relax_edge_margin`` "replans", so that the robot stands where
     the walk's own foothold checks find a plan, and then, if no start
-    held, as ``sets`` say (by default "all": the relaxed checks' plan).
+    held, as ``sets`` say (by default "all": the relaxed checks' plan);
+    ``starts_tried`` counts the starts of both passes.
     """
     sim = {k: v for k, v in sets if not k.startswith("trajectory.")}
     traj = {k.removeprefix("trajectory."): v for k, v in sets if k.startswith("trajectory.")}
@@ -195,13 +196,17 @@ def one_run(
     # The robot is put where the walk's own foothold checks find a plan
     # (a first plan without the relaxed edge margin; re-plans may relax it),
     # and only where no start does, where the relaxed checks find one.
+    margin_counts = all(
+        float(sim.get(f"footstep.{k}", 1.0)) > 0 for k in ("edge_margin", "edge_drop")
+    )
     passes = (
         [{**sim, "executor.relax_edge_margin": "replans"}, sim]
-        if "executor.relax_edge_margin" not in sim
+        if "executor.relax_edge_margin" not in sim and margin_counts
         else [sim]
     )
     held = False
-    for settings in passes:
+    for k, settings in enumerate(passes):
+        last = k == len(passes) - 1
         for dx, dy in START_NUDGES:
             tried += 1
             where = (start[0] + dx, start[1] + dy, start[2])
@@ -218,7 +223,9 @@ def one_run(
                     "outcome.time_limit_s": PROBE_S,
                 },
             )
-            if not stands_where_put(probe):
+            if not stands_where_put(probe) or (
+                not last and probe.outcome.reason.startswith("no plan")
+            ):
                 continue
             result = run(
                 "littledog",
@@ -231,7 +238,11 @@ def one_run(
             )
             # The run's longer planning can start from another first pose than
             # the probe's, which may not hold either: then re-place the robot.
-            held = stands_where_put(result)
+            # In the first pass, a first plan that failed for any reason
+            # (a search the margin left without a route) leaves the relaxed pass.
+            held = stands_where_put(result) and (
+                last or not result.outcome.reason.startswith("no plan")
+            )
             if held:
                 break
         if held:

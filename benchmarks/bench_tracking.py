@@ -667,7 +667,8 @@ def main() -> None:
     parser.add_argument(
         "--add-constraints",
         default="",
-        help="constraints appended to every solve's set, e.g. force_between_nodes",
+        help="constraints appended to every solve's set where it lacks them, "
+        "e.g. force_between_nodes",
     )
     parser.add_argument(
         "--models",
@@ -684,7 +685,7 @@ def main() -> None:
     inits = [v for v in args.init.split(",") if v]
     notes = [f"tracking settings: {dict(tracking)}"] if tracking else []
     notes += [f"NLP settings: {dict(trajopt)}"] if trajopt else []
-    added = tuple(v for v in args.add_constraints.split(",") if v)
+    added = tuple(dict.fromkeys(v for v in args.add_constraints.split(",") if v))
     notes += [f"constraints added: {added}"] if added else []
     if any(i.partition(":")[0] in LEARNED for i in inits):
         why = learned_available()

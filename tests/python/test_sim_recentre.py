@@ -45,7 +45,9 @@ RH = 3
 def settled(littledog_board):
     robot = rw.load_robot("littledog")
     terrain = littledog_board("AE")
-    source = PlannerSource(robot, terrain, expansions=40000, config=planner_config(robot, 0.4, {}))
+    # The walk's settings of session 21, before the 1 cm edge margin.
+    config = planner_config(robot, 0.4, {"edge_margin": 0.0})
+    source = PlannerSource(robot, terrain, expansions=40000, config=config)
     return robot, terrain, source
 
 

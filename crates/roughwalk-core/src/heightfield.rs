@@ -245,8 +245,9 @@ impl HeightField {
 
     /// Unit upward normal of the mean slope over the disc of `radius` [m]
     /// around (x, y): the bilinear gradient averaged over the points of a
-    /// square grid of spacing r / ⌈r / min(dx, dy)⌉ within the disc, the
-    /// mean gradient the foothold slope checks judge a foot's disc by.
+    /// square grid of spacing r / ⌈r / min(dx, dy)⌉ within the disc: about
+    /// the mean gradient the foothold slope checks judge a foot's disc by
+    /// (they average central differences at the grid points).
     /// `radius` ≤ 0 gives [`normal`](Self::normal) at the point.
     pub fn disc_normal(&self, x: f64, y: f64, radius: f64) -> [f64; 3] {
         if radius <= 0.0 {
@@ -360,9 +361,9 @@ mod tests {
         let point = hf.normal(0.001, 0.0, Interpolation::Bilinear);
         assert!((point[2] - 0.5_f64.sqrt()).abs() < 1e-12);
         let disc = hf.disc_normal(0.001, 0.0, 0.03);
-        // Mean gradient over the 29 grid points within 3 cm: the column at
-        // x = 0.001 - 0.01·k, k ∈ {0, 1, 2, 3}, lies right of the ridge for
-        // k = 0 only; brute force over the same points.
+        // Brute force over the same 29 points within 3 cm, at x = 0.001 +
+        // 0.01·i: the 18 with i ≥ 0 lie right of the ridge (slope −1), the
+        // 11 with i < 0 left of it (+1).
         let (mut gx, mut count) = (0.0_f64, 0.0_f64);
         for i in -3i32..=3 {
             for j in -3i32..=3 {

@@ -213,7 +213,9 @@ class FootstepConfig:
         against 20 with the point normal. Along the point normal the
         sphere touches the terrain at the contact point itself; along the
         disc's it meets the rock beside it first, wherever the two lean
-        apart, and lands off its foothold. So 0 stays.
+        apart, and lands off its foothold. So 0 stays. Its precomputation
+        grows with (r / grid spacing)²: about 300 gradients per lattice
+        cell at the foot radius on the 1.2 mm boards.
     actions:
         Footstep displacements (dx, dy, dθ) [m, m, rad] of the moving leg in
         the heading frame, added to its nominal place around the feet's
@@ -310,15 +312,15 @@ class FootstepConfig:
         session 23): a touchdown lands a median 3 mm (90th percentile
         6 mm, worst 11 mm) from its planned foot centre (224 touchdowns of
         large rocks seeds 0–31), and the foot centre sits downhill of the
-        contact the check judges. Large rocks seed 9 put RF 8 mm off its
-        plan on the rim of a 5 cm rock, where it hung by its edge and slid
-        as the trunk shifted. In five of the seven runs that failed
-        without the margin (seeds 13, 16, 24, 27, 28), when the first
-        reflex fired a standing foot's planned centre was 6–12 mm from
-        ground 3 cm below its sole, and the foot itself 1–6 mm. With the
-        walk's 3 cm ``edge_drop`` and 45° ``max_foothold_slope``, 1 cm
-        leaves no foothold on 49 % of board AE's cells (41 % with 0), AC
-        36 % (29), Y 37 % (28), AD 59 % (48).
+        contact the check judges. Large rocks seed 9 (with the opt-in
+        ``normal_radius``) put RF 8 mm off its plan on the rim of a 5 cm
+        rock, where it hung by its edge and slid as the trunk shifted. In
+        five of the seven runs that failed without the margin (seeds 13,
+        16, 24, 27, 28), when the first reflex fired a standing foot's
+        planned centre was 6–12 mm from ground 3 cm below its sole, and the
+        foot itself 1–6 mm. With the walk's 3 cm ``edge_drop`` and 45°
+        ``max_foothold_slope``, 1 cm leaves no foothold on 49 % of board
+        AE's cells (41 % with 0), AC 36 % (29), Y 37 % (28), AD 59 % (48).
     max_foothold_slope:
         A cell is no foothold where the terrain's mean slope over the foot's
         disc is steeper than this [rad]

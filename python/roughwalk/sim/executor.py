@@ -247,7 +247,11 @@ class Executor:
             prepared = self.generator.prepare(attempt.plan)
         except PlanningError as e:
             failed = PlanAttempt(
-                None, "INVALID", f"the plan cannot be executed: {e}", attempt.wall_s
+                None,
+                "INVALID",
+                f"the plan cannot be executed: {e}",
+                attempt.wall_s,
+                relaxed=attempt.relaxed,
             )
             return None, failed, time.perf_counter() - began
         self.plans.append(attempt.plan)

@@ -171,8 +171,9 @@ def run(
     }
     options["config"] = planner_config(robot_obj, cfg.executor.longest_step, footstep)
     relax = cfg.executor.relax_edge_margin
-    if relax != "none" and options["config"].edge_margin > 0:
-        options["fallback"] = replace(options["config"], edge_margin=0.0)
+    walk = options["config"]
+    if relax != "none" and walk.edge_margin > 0 and walk.edge_drop > 0:
+        options["fallback"] = replace(walk, edge_margin=0.0)
         options["fallback_from_pose"] = relax == "all"
     if isinstance(planner, str):
         if planner == "auto":

@@ -230,8 +230,9 @@ class Terrain:
         """Unit upward normals (N, 3) of the mean slope over the disc of ``radius`` [m] at ``xy``.
 
         The bilinear gradient averaged over the points of a square grid of
-        spacing r / ⌈r / min(dx, dy)⌉ within the disc: the mean slope the
-        foothold checks judge a foot's disc by
+        spacing r / ⌈r / min(dx, dy)⌉ within the disc: about the mean slope
+        the foothold checks judge a foot's disc by (they average central
+        differences at the grid points)
         (:func:`~roughwalk.planning.foothold_safety.steep_footholds`), and
         the footstep planner's foot-centre normal with
         ``footstep.normal_radius``. ``radius`` 0 gives :meth:`normal`.

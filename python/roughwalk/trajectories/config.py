@@ -914,7 +914,8 @@ class TrajectoryConfig:
         planner's own centre); "disc", the contact plus the foot radius
         along the normal of the mean slope over the foot's disc
         (:meth:`~roughwalk.terrain.terrain.Terrain.disc_normal`; the
-        planner's centre with ``footstep.normal_radius`` the foot radius;
+        planner's centre with ``footstep.normal_radius`` the foot radius,
+        which it needs: a certificate's foot within 1 cm wins;
         large rocks walk worse with both, figures there);
         "resting", where the sphere rests lowered
         straight onto the contact's (x, y), over the whole foot's disc as

@@ -11,7 +11,11 @@ and optionally ``initial_pose``, the initial stance's certificate.
 Trajectories need foot-sphere centres: a contact point plus the foot radius
 along the terrain's normal, or, where a certificate places that foot within
 a centimetre of it, exactly where the certificate's joint angles put it (the
-centre the planner checked). With ``foot_centre="resting"`` the centre is
+centre the planner checked). With ``foot_centre="disc"`` the normal is the
+mean slope's over the foot's disc instead, the planner's own with
+``footstep.normal_radius`` the foot radius (the two go together: a
+certificate's foot within a centimetre wins either way). With
+``foot_centre="resting"`` the centre is
 instead where the sphere rests when lowered straight onto the contact's
 (x, y) (:func:`~roughwalk.planning.foothold_safety.resting_centres`): the
 normal is that of the one grid point under the contact, and on a scanned
@@ -160,9 +164,9 @@ def _foot_centres(
     "resting": the sphere lowered straight onto the contact's (x, y)
     rests there (needs ``terrain``; without it, "normal").
 
-    The normal is the bilinear one at the contact point, over one grid
-    cell (1.2 mm on the LittleDog boards), while the planner judges a
-    foothold's slope over the foot's disc. Of the board cells whose disc
+    For "normal", the normal is the bilinear one at the contact point,
+    over one grid cell (1.2 mm on the LittleDog boards), while the planner
+    judges a foothold's slope over the foot's disc. Of the board cells whose disc
     slopes less than 45°, 11–12 % have a point normal steeper than 45°,
     and there the centre along it sinks into the rock beside the contact
     (AE: by over 2 mm at 14 % of them, by 25 mm at the 99th percentile;
