@@ -79,6 +79,8 @@ def test_a_run_plans_relaxed_by_default_and_says_so(terrain: Terrain) -> None:
     plan = next(e for e in result.log.events if e["kind"] == "plan")
     assert plan["status"] == "solved" and plan["relaxed"] is True
     assert not result.outcome.reason.startswith("no plan")
+    assert result.outcome.relaxed_plans == 1
+    assert result.to_dict()["relaxed_plans"] == 1
     for relax in ("replans", "none"):
         off = run(
             "littledog",
@@ -89,7 +91,7 @@ def test_a_run_plans_relaxed_by_default_and_says_so(terrain: Terrain) -> None:
             **settings,
             **{"executor.relax_edge_margin": relax},
         )
-        assert off.outcome.reason.startswith("no plan")
+        assert off.outcome.reason.startswith("no plan") and off.outcome.relaxed_plans == 0
         assert next(e for e in off.log.events if e["kind"] == "plan")["relaxed"] is False
 
 

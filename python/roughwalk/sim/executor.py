@@ -491,6 +491,9 @@ class Executor:
             wait_s=wait_s,
             replan_s=replan_s,
             steps=steps_done,
+            relaxed_plans=sum(
+                1 for e in self.log.events if e["kind"] in ("plan", "replan") and e.get("relaxed")
+            ),
             failure=failure,
             extra={
                 "max_actuator_force_ratio": float(

@@ -63,6 +63,10 @@ class Outcome:
         (:attr:`~roughwalk.sim.measured_state.MeasuredState.self_contact`).
     steps:
         Footsteps executed to completion.
+    relaxed_plans:
+        Plans (the first or re-plans) that came from the footstep source's
+        second planner, without the edge margin
+        (:attr:`~roughwalk.sim.config.ExecutorConfig.relax_edge_margin`).
     """
 
     success: bool
@@ -82,6 +86,7 @@ class Outcome:
     shin_contacts: int = 0
     self_contacts: int = 0
     steps: int = 0
+    relaxed_plans: int = 0
     extra: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
@@ -195,6 +200,7 @@ class OutcomeMonitor:
         wait_s: float = 0.0,
         replan_s: float = 0.0,
         steps: int = 0,
+        relaxed_plans: int = 0,
         failure: str | None = None,
         extra: dict[str, Any] | None = None,
     ) -> Outcome:
@@ -236,5 +242,6 @@ class OutcomeMonitor:
             shin_contacts=self.shin_contacts,
             self_contacts=self.self_contacts,
             steps=steps,
+            relaxed_plans=relaxed_plans,
             extra=dict(extra or {}),
         )

@@ -22,6 +22,7 @@ _ROWS = (
     ("speed_cm_s", "average speed", "cm/s"),
     ("reflexes", "reflexes", ""),
     ("replans", "re-plans", ""),
+    ("relaxed_plans", "plans without the edge margin", ""),
     ("foot_slips", "foot slips", ""),
     ("wait_s", "waiting for optimisation", "s"),
     ("replan_s", "standing while re-planning", "s"),
