@@ -42,13 +42,12 @@ def test_longer_steps_raise_the_travel_cap_up_to_the_reach(littledog) -> None:
     length = hip_to_hip_length(littledog)
     default = FootstepConfig.for_robot(littledog)
     assert longer_step_config(littledog, 0.3) == default
-    # 0.375 L makes the default cap's stride: the cap stays.
-    assert longer_step_config(littledog, 0.375).max_foot_travel == pytest.approx(
-        default.max_foot_travel
-    )
+    # Longer actions raise the cap to the reach's share, past the steady stride they make.
+    cap = STRIDE_REACH_SHARE * stride_reach(littledog)
     longer = longer_step_config(littledog, 0.4)
-    assert longer.max_foot_travel == pytest.approx(STRIDE_PER_ACTION * 0.4 * length)
+    assert longer.max_foot_travel == pytest.approx(cap)
+    assert longer.max_foot_travel > STRIDE_PER_ACTION * 0.4 * length
     assert max(a[0] for a in longer.actions) == pytest.approx(0.4 * length)
     too_long = longer_step_config(littledog, 0.6)
-    assert too_long.max_foot_travel == pytest.approx(STRIDE_REACH_SHARE * stride_reach(littledog))
+    assert too_long.max_foot_travel == pytest.approx(cap)
     assert too_long.max_foot_travel < STRIDE_PER_ACTION * 0.6 * length

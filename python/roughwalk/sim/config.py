@@ -994,9 +994,10 @@ class ExecutorConfig:
         1.6 times the longest action (9.6 cm at 0.3 L on LittleDog, whose
         swings are joint-speed limited at 0.28–0.32 s: longer strides carry
         the feet farther per swing); ``footstep.max_foot_travel`` (0.6 L)
-        grows with it up to 0.85 of the fore–aft span a foot reaches
-        (:mod:`roughwalk.sim.stride_reach`; 0.159 m, so ~0.42 L on
-        LittleDog). 0.4 by default since session 15, with the fast swing
+        then grows to 0.88 of the fore–aft span a foot reaches
+        (:mod:`roughwalk.sim.stride_reach`; 0.159 m, so 0.14 m on LittleDog;
+        to the steady stride, 0.129 m at 0.4 L, before session 24). 0.4 by
+        default since session 15, with the fast swing
         options and ``swing.lift_off_reach`` (see
         :class:`~roughwalk.trajectories.config.SwingConfig`'s ``path``); with
         the former "even" swings longer strides lengthened the

@@ -18,9 +18,11 @@ __all__ = ["longer_step_config", "stride_reach", "STRIDE_REACH_SHARE", "STRIDE_P
 
 # A steady crawl's stride over its longest forward action (4 steps of ~0.4 of it each).
 STRIDE_PER_ACTION = 1.6
-# Share of the reachable span a stride may use: the rest is left to the
+# Share of the reachable span one foot's move may use: the rest is left to the
 # trunk's sway and tilt on rough ground, which move the hips under the feet.
-STRIDE_REACH_SHARE = 0.85
+# 0.88 (~0.14 m on LittleDog) since session 24; before, the cap was the
+# steady stride, 1.6 × the longest action (0.129 m at 0.4 L).
+STRIDE_REACH_SHARE = 0.88
 # Resolution [m] of the reach scan.
 _SCAN_M = 0.002
 
@@ -53,11 +55,12 @@ def stride_reach(robot: Any) -> float:
 def longer_step_config(robot: Any, longest: float) -> Any:
     """The footstep planner's settings with forward actions of ``longest`` × L added.
 
-    ``footstep.max_foot_travel`` grows to the stride those actions make
-    (:data:`STRIDE_PER_ACTION` times the action) where it was shorter, up to
-    :data:`STRIDE_REACH_SHARE` of :func:`stride_reach`; beyond that the
-    longer actions would only be cut back by the travel cap. The planner's
-    pose certificates still check every stance's reach.
+    ``footstep.max_foot_travel`` grows to :data:`STRIDE_REACH_SHARE` of
+    :func:`stride_reach` where it was shorter: a steady crawl's stride is
+    only :data:`STRIDE_PER_ACTION` times the longest action, but the
+    search's sideways actions and its local search around each target make
+    single moves longer than that, and a cap at the steady stride cut them
+    back. The planner's pose certificates still check every stance's reach.
     """
     from roughwalk.planning.footstep_config import FootstepConfig, hip_to_hip_length
 
@@ -66,7 +69,7 @@ def longer_step_config(robot: Any, longest: float) -> Any:
     if longest * length <= max(a[0] for a in base.actions) + 1e-12:
         return base
     extra = tuple((longest * length, dy * length, 0.0) for dy in (-0.1, 0.0, 0.1))
-    travel = min(STRIDE_PER_ACTION * longest * length, STRIDE_REACH_SHARE * stride_reach(robot))
+    travel = STRIDE_REACH_SHARE * stride_reach(robot)
     return FootstepConfig.for_robot(
         robot,
         actions=base.actions + extra,
