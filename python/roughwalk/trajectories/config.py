@@ -639,6 +639,20 @@ class SwingConfig:
         push (``bench_push_recovery.py --from 1.6 --to 3.2 --direction
         -90``) survives 6 of 9 against 7 (2.0 s, in LF's swing on level
         ground, rolls over), hence off; see ``law_trunk_rise``.
+        Session 25 (``docs/measurements.md``; one process per seed through
+        ``bench_littledog.py --expansions 40000``'s run, every class against
+        the defaults on the same seeds): under the swing pose a step into
+        or out of the gap course's trench ran its hip at 0.9 of its limit
+        only at lift-off and drop-off (0.3 between; 0.58–0.94 s swings),
+        under the moving trunk at 0.6–0.9 throughout (0.46–0.64 s). Large
+        rocks seeds 0–63 63/64 at 7.18 cm/s → 64/64 at 7.91, round rocks
+        seeds 0–7 7.90 → 9.14, the 0.8 m gap 7.79 → 9.00 (the other six
+        classes' seeds 0–7 48/48 either way); but the 1.5 m
+        gap course (``--full``) 10/10 at 7.14 → 8/10 at 8.25: as a hind
+        foot climbs out of the trench the planned trunk sits on the
+        diagonal of the other three feet, the front foot off it unloads,
+        and two runs roll over; the right push 7/9 → 6/9. Still off until
+        that trench exit keeps its support.
     law_trunk_rise:
         With ``law_trunk`` "moving", only swings whose target lies at least
         this far [m] above or below their start are paced under the moving
