@@ -242,6 +242,43 @@ def test_generate_cli_selects_far_starts_and_checks_jitter(
     assert not (tmp_path / "bad" / "dataset.npz").exists()
 
 
+def test_generate_cli_keeps_starts_within_the_y_bounds_and_the_box(tmp_path: Path) -> None:
+    """``--start-y-max`` / ``--start-y-min`` solve only the starts right / left of a y, and
+    with the x bounds only those in the box: every stored start lies within the bounds,
+    and every task of the span that lies within them is solved (tasks from
+    ``--first-task`` on)."""
+    from roughwalk.cli.main import main
+    from roughwalk.learning.task_space import ENVIRONMENTS
+
+    space = ENVIRONMENTS["flat"]
+    span = range(3, 15)
+    starts = {i: space.task(i).start for i in span}
+    x_cut = float(np.median([s[0] for s in starts.values()]))
+    y_cut = float(np.median([s[1] for s in starts.values()]))
+    common = ["init", "generate", "--env", "flat", "--steps", "4", "--duration", "2.0"]
+    common += ["--tasks", "12", "--first-task", "3", "--max-iter", "0"]
+    cases = {
+        "right": (["--start-y-max", str(y_cut)], lambda s: s[1] <= y_cut),
+        "left": (["--start-y-min", str(y_cut)], lambda s: s[1] >= y_cut),
+        "corner": (
+            ["--start-x-max", str(x_cut), "--start-y-max", str(y_cut)],
+            lambda s: s[0] <= x_cut and s[1] <= y_cut,
+        ),
+    }
+    for name, (bounds, inside) in cases.items():
+        out = tmp_path / name
+        assert main([*common, *bounds, "--out", str(out)]) == 0
+        run = read_run(out)
+        wanted = [i for i in span if inside(starts[i])]
+        assert 0 < len(wanted) < len(span)
+        assert run["index"].tolist() == wanted
+        assert all(inside(start) for start in run["start"])
+        assert np.array_equal(run["start"], [starts[i] for i in wanted])
+    # The box is the x bounds' and the y bounds' intersection, not the y bound alone.
+    corner = set(read_run(tmp_path / "corner")["index"].tolist())
+    assert corner < set(read_run(tmp_path / "right")["index"].tolist())
+
+
 def test_generate_cli_first_task_gives_fresh_tasks_that_aggregate(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

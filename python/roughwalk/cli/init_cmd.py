@@ -125,6 +125,18 @@ def register(sub: Any) -> None:
         help="solve only the tasks (of the --tasks from --first-task) whose start x is at least "
         "this (m)",
     )
+    g.add_argument(
+        "--start-y-max",
+        type=float,
+        help="solve only the tasks (of the --tasks from --first-task) whose start y is at most "
+        "this (m; y left, so -0.3 keeps starts right of the centre line)",
+    )
+    g.add_argument(
+        "--start-y-min",
+        type=float,
+        help="solve only the tasks (of the --tasks from --first-task) whose start y is at least "
+        "this (m)",
+    )
     g.set_defaults(func=cmd_generate)
 
     t = s.add_parser("train", help="filter a dataset and fit the learned initialiser")
@@ -239,13 +251,12 @@ def cmd_generate(args: argparse.Namespace) -> int:
         )
     span = range(args.first_task, args.first_task + args.tasks)
     indices = None if args.first_task == 0 else list(span)
-    if args.start_x_max is not None or args.start_x_min is not None:
-        low = -math.inf if args.start_x_min is None else args.start_x_min
-        high = math.inf if args.start_x_max is None else args.start_x_max
+    box = (args.start_x_min, args.start_x_max, args.start_y_min, args.start_y_max)
+    if any(bound is not None for bound in box):
         indices = [
             i
             for i in span
-            if low <= space.task(i, seed=args.seed, split=args.split).start[0] <= high
+            if _start_in_box(space.task(i, seed=args.seed, split=args.split).start, box)
         ]
     executor = make_executor(args.executor, workers=args.workers, address=args.address)
     n = args.tasks if indices is None else len(indices)
@@ -271,6 +282,20 @@ def cmd_generate(args: argparse.Namespace) -> int:
     solved = int(sum(s in ("exact", "approximate") for s in data["status"]))
     print(f"{len(data)} tasks in {out / 'dataset.npz'}: {solved} converged")
     return 0
+
+
+def _start_in_box(
+    start: tuple[float, float, float],
+    box: tuple[float | None, float | None, float | None, float | None],
+) -> bool:
+    """Whether a start's x and y [m] lie in ``box`` = (x_min, x_max, y_min, y_max).
+
+    The bounds are inclusive; a missing one (None) leaves that side open.
+    """
+    x_min, x_max, y_min, y_max = (
+        math.inf * s if b is None else b for b, s in zip(box, (-1, 1, -1, 1), strict=True)
+    )
+    return x_min <= start[0] <= x_max and y_min <= start[1] <= y_max
 
 
 def _jitter(text: str | None, learned: bool) -> tuple[float, float, float] | None:
