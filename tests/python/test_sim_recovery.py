@@ -14,6 +14,7 @@ from roughwalk.sim.config import ReflexConfig, SimConfig
 from roughwalk.sim.executor import Executor, nudged_stances
 from roughwalk.sim.recovery import (
     centred_fit,
+    nearer_catch,
     off_edge,
     recently_loaded,
     recovery_segment,
@@ -189,6 +190,63 @@ def test_a_foot_caught_over_a_steps_edge_goes_down_on_the_step_not_on_its_corner
     # With no flat ground within reach, the catch stays.
     corner = off_edge(steps, at_reflex.feet[1], planned[1], r, 0.0)
     np.testing.assert_allclose(corner, at_reflex.feet[1])
+
+
+def test_a_foot_caught_climbing_out_of_a_trench_goes_down_on_its_lip_with_catch_nearer(
+    standing,
+) -> None:
+    """``reflex.catch_nearer``: the flat ground nearest the foot on its way out of a trench.
+
+    The gap course's trench spans x 0.94–1.06 m, 10 cm deep. RH, caught 3
+    cm over the lip's height and still over the floor, 2 cm short of the far
+    wall, goes back down to the floor by default; with the option it lands
+    on the lip, short of its planned foothold 6 cm further on, its foot 1 cm
+    clear of the edge.
+    """
+    robot, _, measured = standing
+    gap = roughwalk.load_terrain("gap")
+    r = robot.foot_radius
+    base = np.array([1.12, 0.0, measured.base_pos[2]])
+    feet = robot.nominal_stance.feet + base * np.array([1.0, 1.0, 0.0])
+    feet[:, 2] = r
+    feet[3] = [1.04, feet[3, 1], 0.03]  # RH over the trench, short of its far wall
+    at_reflex = dataclasses.replace(measured, base_pos=base, base_vel=np.zeros(3), feet=feet)
+    planned = feet.copy()
+    planned[3] = [1.14, feet[3, 1], r]
+    down = np.array([True, True, True, False])
+    _, held = recovery_segment(robot, gap, at_reflex, planned, down, 0.5, 0.3, 0.0)
+    assert gap.height(held[3:, :2])[0] == pytest.approx(-0.1)
+    _, held = recovery_segment(
+        robot, gap, at_reflex, planned, down, 0.5, 0.3, 0.0, catch_nearer=True
+    )
+    assert gap.height(held[3:, :2])[0] == pytest.approx(0.0)
+    assert 1.06 + r + 0.01 <= held[3, 0] < 1.06 + r + 0.01 + 0.005  # the nearest such ground
+    np.testing.assert_allclose(held[3, 1], feet[3, 1])  # on the way to the planned foothold
+    np.testing.assert_allclose(held[:3], feet[:3])  # the standing feet stay
+
+
+def test_nearer_catch_needs_nearer_flat_ground_and_a_way_over_it() -> None:
+    r = 0.0103
+    gap = roughwalk.load_terrain("gap")
+    flat = roughwalk.load_terrain("flat")
+    lip = np.array([1.14, 0.0, r])
+    # Over the floor near the far wall, 3 cm up: the lip is nearer than the floor.
+    high = np.array([1.04, 0.0, 0.03])
+    land = nearer_catch(gap, high, high, lip, r)
+    assert land is not None and np.linalg.norm(land - high) < 0.1
+    # Planned on the edge itself: no landing has the flat margin around it.
+    assert nearer_catch(gap, high, high, np.array([1.07, 0.0, r]), r) is None
+    # Below the lip's height, 1 cm from the wall: the lip is nearer than the
+    # floor, but the straight arched way there runs the sole into the wall.
+    low = np.array([1.05, 0.0, -0.01])
+    assert np.linalg.norm(np.array([1.085, 0.0, r]) - low) < 0.09
+    assert nearer_catch(gap, low, low, lip, r) is None
+    # On flat ground straight down is always the nearest.
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        foot = np.array([0.5, 0.0, r]) + rng.uniform([-0.03, -0.03, 0.0], [0.03, 0.03, 0.06])
+        planned = np.array([*(foot[:2] + rng.uniform(-0.06, 0.06, 2)), r])
+        assert nearer_catch(flat, foot, foot, planned, r) is None
 
 
 def test_the_trunk_settles_with_its_centre_of_mass_over_the_feet_on_a_tilted_stance() -> None:

@@ -605,6 +605,13 @@ class ReflexConfig:
         moving towards goes down v·√(h/g) further that way (0: straight
         down). Longer catches harder pushes and may ask for a foot beyond
         the leg's reach (it then lands as near as the leg gets).
+    catch_nearer:
+        A lifted foot the recovery puts down lands on the flat ground
+        nearest to it between straight below and its planned foothold,
+        where that is nearer than straight below and the arched way there
+        clears the ground (:func:`~roughwalk.sim.recovery.nearer_catch`):
+        a hind foot caught over a trench as it climbs out lands on the lip,
+        not 10 cm down at the bottom.
     replan_budget_s:
         Time the anytime planner gets to re-plan [s] (the paper's target: walk
         again within 2 s).
@@ -832,6 +839,7 @@ class ReflexConfig:
     settled_loaded_feet: int = 3
     lower_s: float = 0.5
     capture_max_m: float = 0.04
+    catch_nearer: bool = False
     replan_budget_s: float = 2.0
     standing_bear: bool = True
     loaded_window_s: float = 0.0

@@ -664,6 +664,7 @@ class Executor:
             now,
             capture_max_m=cfg.capture_max_m,
             bearing=bearing,
+            catch_nearer=cfg.catch_nearer,
         )
         for s in segments:
             self.buffer.append(s)

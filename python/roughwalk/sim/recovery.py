@@ -54,6 +54,7 @@ __all__ = [
     "pose_segment",
     "min_jerk",
     "off_edge",
+    "nearer_catch",
     "standing_feet",
     "near_ground",
     "recently_loaded",
@@ -261,6 +262,19 @@ def centred_fit(
     return fit, rpy
 
 
+def _ring(radius: float) -> NDArray[np.float64]:
+    """Offsets (9, 2) [m]: a centre and eight points ``radius`` around it."""
+    a = np.linspace(0.0, 2.0 * np.pi, 8, endpoint=False)
+    return np.vstack([[0.0, 0.0], radius * np.column_stack([np.cos(a), np.sin(a)])])
+
+
+def _under_foot(foot_radius: float) -> NDArray[np.float64]:
+    """Offsets (5, 2) [m] of the ground under a foot: its centre, half a radius around."""
+    return (
+        0.5 * foot_radius * np.array([[0.0, 0.0], [1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
+    )
+
+
 def off_edge(
     terrain: Terrain,
     catch: NDArray[np.float64],
@@ -284,9 +298,7 @@ def off_edge(
     start = np.asarray(catch, dtype=float)
     way = np.asarray(toward, dtype=float)[:2] - start[:2]
     length = float(np.linalg.norm(way))
-    ring = (
-        0.5 * foot_radius * np.array([[0.0, 0.0], [1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
-    )
+    ring = _under_foot(foot_radius)
     steps = int(np.floor(min(reach, length) / EDGE_STEP_M + 1e-9))
     for k in range(steps + 1):
         xy = start[:2] + (k * EDGE_STEP_M / length) * way if k else start[:2]
@@ -363,6 +375,83 @@ def settled(measured: MeasuredState, rate_rad_s: float, loaded_feet: int, loaded
     return turning < rate_rad_s and loaded >= loaded_feet
 
 
+CATCH_STEP_M = 0.005
+"""Spacing [m] of :func:`nearer_catch`'s candidate landings."""
+CATCH_EDGE_M = 0.01
+"""Flat ground [m] beyond the foot's radius a :func:`nearer_catch` landing
+needs around it (the walk's ``footstep.edge_margin``)."""
+CATCH_CLEAR_M = 0.002
+"""Least height [m] of a lowered foot's sole over the ground along its way
+to the planned foothold, for :func:`nearer_catch` to send it there."""
+ARCH_M = 0.015
+"""Height [m] of the arch a lowered foot moving across makes (part 1 of
+:func:`recovery_segment`)."""
+
+
+def _arched_way(
+    start: NDArray[np.float64], goal: NDArray[np.float64], k: int
+) -> NDArray[np.float64]:
+    """``k`` points (k, 3) from ``start`` to ``goal``, straight with the recovery's arch."""
+    s = np.linspace(0.0, 1.0, k)
+    way = (1.0 - s)[:, None] * start[None] + s[:, None] * goal[None]
+    if np.linalg.norm(goal[:2] - start[:2]) > 0.02:
+        way[:, 2] += ARCH_M * np.sin(np.pi * s)
+    return way
+
+
+def nearer_catch(
+    terrain: Terrain,
+    foot: NDArray[np.float64],
+    catch: NDArray[np.float64],
+    planned: NDArray[np.float64],
+    foot_radius: float,
+) -> NDArray[np.float64] | None:
+    """A landing (3,) [m] for a lifted foot at ``foot`` (3,) nearer than ``catch``, else None.
+
+    ``catch`` is where the recovery would put the foot down (straight
+    below, :func:`off_edge`), ``planned`` its planned foothold, both (3,)
+    foot centres; only their ground heights count. The candidates lie on
+    the line from the catch to the planned foothold, every
+    :data:`CATCH_STEP_M`: each on ground flat (within
+    :data:`EDGE_RISE_M`) out to :data:`CATCH_EDGE_M` beyond the foot's
+    radius, and reached along the foot's arched straight way with its sole
+    :data:`CATCH_CLEAR_M` over the ground (sampled at the foot's centre
+    and half a radius around it). The nearest to the foot wins if it is
+    nearer than the catch. On the LittleDog 1.5 m gap course (``bench
+    littledog --full``, seed 6, ``swing.law_trunk`` "moving") the
+    foot-force reflex fired as RH, 3 cm over the trench's lip and still
+    over the trench floor, climbed out of the 10 cm deep trench; the
+    recovery put RH back down on the floor, 12 cm below, and the trunk
+    rolled over towards it.
+    """
+    foot = np.asarray(foot, dtype=float)
+    start = np.asarray(catch, dtype=float)
+    way = np.asarray(planned, dtype=float)[:2] - start[:2]
+    length = float(np.linalg.norm(way))
+    ground = float(np.asarray(terrain.height(start[None, :2]), dtype=float)[0])
+    best = float(np.linalg.norm(foot - np.array([start[0], start[1], ground + foot_radius])))
+    if length < CATCH_STEP_M:
+        return None
+    rim = _ring(foot_radius + CATCH_EDGE_M)
+    under = _under_foot(foot_radius)
+    found = None
+    for k in range(1, int(np.floor(length / CATCH_STEP_M + 1e-9)) + 1):
+        xy = start[:2] + min(1.0, k * CATCH_STEP_M / length) * way
+        z = np.asarray(terrain.height(xy[None] + rim), dtype=float)
+        if float(np.ptp(z)) > EDGE_RISE_M:
+            continue
+        land = np.array([xy[0], xy[1], float(terrain.height(xy[None])[0]) + foot_radius])
+        distance = float(np.linalg.norm(land - foot))
+        if distance >= best:
+            continue
+        path = _arched_way(foot, land, 17)[1:-1]
+        heights = terrain.height((path[:, None, :2] + under[None]).reshape(-1, 2))
+        top = np.asarray(heights, dtype=float).reshape(len(path), len(under)).max(axis=1)
+        if np.all(path[:, 2] - foot_radius - top >= CATCH_CLEAR_M):
+            best, found = distance, land
+    return found
+
+
 def recovery_segment(
     robot: Robot,
     terrain: Terrain,
@@ -375,6 +464,7 @@ def recovery_segment(
     press_m: float = 0.0,
     capture_max_m: float = 0.0,
     bearing: NDArray[np.bool_] | None = None,
+    catch_nearer: bool = False,
 ) -> tuple[list[Segment], NDArray[np.float64]]:
     """The reflex's motion from ``measured``: feet down, trunk over them, hold.
 
@@ -397,6 +487,12 @@ def recovery_segment(
         (:func:`standing_feet`; default ``in_contact``). A foot both put
         down and bearing keeps its load as it moves the few millimetres to
         the ground.
+    catch_nearer:
+        A lifted foot goes down on the flat ground nearest to it on the way
+        to its planned foothold instead of straight down, where that is
+        nearer and the way there clears the ground (:func:`nearer_catch`):
+        a foot climbing out of a trench, caught over its floor, lands on
+        the lip rather than back at the bottom.
 
     Returns the segments and the four footholds (4, 3) [m] the robot ends on.
     """
@@ -418,6 +514,11 @@ def recovery_segment(
         goal = planned.copy()
         if np.linalg.norm(goal[:2] - catch[:2]) > 0.02:
             goal = off_edge(terrain, catch, planned, r, EDGE_REACH_M)
+            nearer = (
+                nearer_catch(terrain, start_feet[leg], goal, planned, r) if catch_nearer else None
+            )
+            if nearer is not None:
+                goal = nearer
         # "Firmly on the ground": aim a little into it, so the servo presses
         # the foot down and the pressing legs stop the trunk tipping.
         goal[2] = float(terrain.height(goal[None, :2])[0]) + r - press_m
@@ -427,7 +528,7 @@ def recovery_segment(
     k = 9
     s = np.linspace(0.0, 1.0, k)
     feet = (1.0 - s)[:, None, None] * start_feet[None] + s[:, None, None] * target[None]
-    arch = 0.015 * np.sin(np.pi * s)
+    arch = ARCH_M * np.sin(np.pi * s)
     moving = np.linalg.norm(target[:, :2] - start_feet[:, :2], axis=1) > 0.02
     feet[:, moving, 2] += arch[:, None]
     support = np.asarray(in_contact if bearing is None else bearing, dtype=bool)
