@@ -241,12 +241,14 @@ def test_nearer_catch_needs_nearer_flat_ground_and_a_way_over_it() -> None:
     low = np.array([1.05, 0.0, -0.01])
     assert np.linalg.norm(np.array([1.085, 0.0, r]) - low) < 0.09
     assert nearer_catch(gap, low, low, lip, r) is None
-    # On flat ground straight down is always the nearest.
+    # On level ground the catch stays, even moved out by a capture offset
+    # away from a planned foothold nearer the foot.
     rng = np.random.default_rng(3)
     for _ in range(50):
         foot = np.array([0.5, 0.0, r]) + rng.uniform([-0.03, -0.03, 0.0], [0.03, 0.03, 0.06])
+        catch = foot + np.array([*rng.uniform(-0.04, 0.04, 2), 0.0])
         planned = np.array([*(foot[:2] + rng.uniform(-0.06, 0.06, 2)), r])
-        assert nearer_catch(flat, foot, foot, planned, r) is None
+        assert nearer_catch(flat, foot, catch, planned, r) is None
 
 
 def test_the_trunk_settles_with_its_centre_of_mass_over_the_feet_on_a_tilted_stance() -> None:

@@ -416,8 +416,10 @@ def nearer_catch(
     :data:`EDGE_RISE_M`) out to :data:`CATCH_EDGE_M` beyond the foot's
     radius, and reached along the foot's arched straight way with its sole
     :data:`CATCH_CLEAR_M` over the ground (sampled at the foot's centre
-    and half a radius around it). The nearest to the foot wins if it is
-    nearer than the catch. On the LittleDog 1.5 m gap course (``bench
+    and half a radius around it), and higher than the catch's ground by
+    more than :data:`EDGE_RISE_M`, so only a drop is avoided (on level
+    ground the catch keeps its capture offset). The nearest to the foot
+    wins if it is nearer than the catch. On the LittleDog 1.5 m gap course (``bench
     littledog --full``, seed 6, ``swing.law_trunk`` "moving") the
     foot-force reflex fired as RH, 3 cm over the trench's lip and still
     over the trench floor, climbed out of the 10 cm deep trench; the
@@ -441,6 +443,8 @@ def nearer_catch(
         if float(np.ptp(z)) > EDGE_RISE_M:
             continue
         land = np.array([xy[0], xy[1], float(terrain.height(xy[None])[0]) + foot_radius])
+        if land[2] - foot_radius - ground <= EDGE_RISE_M:
+            continue  # no drop avoided (on level ground the catch keeps its capture offset)
         distance = float(np.linalg.norm(land - foot))
         if distance >= best:
             continue
