@@ -10,6 +10,7 @@ EVEN_SWINGS = {
     "swing.path": "cartesian",
     "swing.ramp_fraction": 0.2,
     "swing.lift_off_reach": False,
+    "swing.law_trunk": "swing_pose",
 }
 """``trajectory_config`` keys: the former swing defaults."""
 
