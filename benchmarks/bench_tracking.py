@@ -286,7 +286,7 @@ def learned_problem(
 
     Every initialiser solves the same NLP on an environment: the one the
     learned model was trained on (the double pallet's adds
-    ``unilateral_between_nodes``; a model trained with
+    ``unilateral_between_nodes`` and ``joint_torques``; a model trained with
     ``costs.force_between_nodes_penalty=10`` weighs that term), so that the
     initialisers compare on one problem. ``init`` is "learned" (the shipped
     model), "learned:FILE" or "learned_fixed_durations[:FILE]".

@@ -51,9 +51,15 @@ def flat() -> TerrainModel:
     return TerrainModel(load_terrain("flat"))
 
 
-def _problem(flat: TerrainModel, optimize: bool, bounds: tuple[float, float]) -> TrajoptProblem:
+def _problem(
+    flat: TerrainModel, optimize: bool, bounds: tuple[float, float], admit_gait: bool = True
+) -> TrajoptProblem:
     config = melon_config(
-        steps=STEPS, duration=DURATION, optimize_durations=optimize, phase_duration_bounds=bounds
+        steps=STEPS,
+        duration=DURATION,
+        optimize_durations=optimize,
+        phase_duration_bounds=bounds,
+        phase_bounds_admit_gait=admit_gait,
     )
     return TrajoptProblem(TOWR_ANYMAL, flat, make_gait("walk", STEPS, DURATION), config)
 
@@ -115,7 +121,8 @@ def test_the_multipliers_fill_their_own_rows_and_the_duration_rows_start_at_zero
 def test_an_out_of_bounds_phase_is_clamped_and_the_next_absorbs_it(
     flat: TerrainModel, solved: tuple[TrajoptProblem, TrajoptProblem, object]
 ) -> None:
-    nlp = _problem(flat, True, (0.2, 1.0)).formulation
+    # Bounds that do not admit the gait (phase_bounds_admit_gait off, as in towr_config).
+    nlp = _problem(flat, True, (0.2, 1.0), admit_gait=False).formulation
     gait = make_gait("walk", STEPS, DURATION)
     clamped = 0
     for d, timed, own in zip(nlp.durations, gait_durations(nlp), gait.durations, strict=True):

@@ -37,7 +37,7 @@ def test_the_folder_s_model_that_fits_the_problem_is_used(candidate: Path) -> No
     assert init == f"learned:{candidate / 'candidate.npz'}"
     assert bench.learned_model_for("double_pallet", False, init) == ""
     chosen, costs = bench.learned_problem("double_pallet", False, init)
-    assert chosen == (*MELON_REACH_CONSTRAINTS, "unilateral_between_nodes")
+    assert chosen == (*MELON_REACH_CONSTRAINTS, "unilateral_between_nodes", "joint_torques")
     assert costs is None  # the shipped model records no weights
 
 

@@ -49,18 +49,17 @@ def _double_pallet_job(bench, seed: int, index: int, max_iter: int, tracking=())
 
 
 def test_a_far_corner_double_pallet_walk_tracks_with_footholds_under_the_drifted_trunk() -> None:
-    """Seed 1's task 20 (start x = −0.31 m, y = −0.48 m, yaw −27°), 5 iterations: the plan is
-    near feasible (dynamics rows within 0.12), yet with half the drift added to the
-    footholds the trunk ends 0.58 m right of the plan at 5.96 s and rolls past 45°; with the
-    whole drift it tracks to within 1 cm of the goal."""
+    """Seed 1's task 20 (start x = −0.31 m, y = −0.48 m, yaw −27°), 5 iterations, tracks to
+    within 1 cm of the goal. With session 16's model its plan drifted: with half the drift
+    added to the footholds the trunk ended 0.58 m right of the plan at 5.96 s and rolled
+    past 45°, with the whole drift it tracked. Since session 26 the shipped model's plans
+    (torque-feasible, the start box's corner grown) no longer drift that far: this task and
+    seed 0's 12 and 26, seed 1's 18 and seed 3's 5 and 24 track with half the correction,
+    and this one, seed 0's 12 and seed 1's 18 with none (gain 0), so the contrast no longer
+    shows on a shipped plan."""
     bench = load_benchmark("bench_tracking")
     job = _double_pallet_job(bench, seed=1, index=20, max_iter=5)
     assert np.allclose(job.start, (-0.311, -0.482, -0.476), atol=2e-3)
     tracked = bench.run_job(job)
     assert tracked["success"], tracked["reason"]
-    half = bench.run_job(
-        _double_pallet_job(
-            bench, seed=1, index=20, max_iter=5, tracking=(("gains.foothold_position_gain", "0.5"),)
-        )
-    )
-    assert not half["success"] and half["reason"].startswith("fell"), half["reason"]
+    assert tracked["final_position_error_m"] < 0.01

@@ -227,7 +227,7 @@ def test_double_pallet_climb_converges_under_the_rows(anymal: Robot) -> None:
         gait="walk",
         steps=space.steps,
         duration=space.duration,
-        constraints=(*spec.constraints, "joint_torques"),
+        constraints=tuple(dict.fromkeys((*spec.constraints, "joint_torques"))),
         swing_base_clearance=space.swing_base_clearance,
         dt_joint_torques=0.02,
     )

@@ -15,6 +15,7 @@ from roughwalk.trajopt import (
     HeuristicInitializer,
     TerrainModel,
     make_gait,
+    melon_config,
     towr_config,
     valid_step_counts,
 )
@@ -408,3 +409,36 @@ def test_an_admitted_phase_shorter_than_the_margin_keeps_a_positive_lower_bound(
     assert admitted.lower[0] == pytest.approx(0.003)
     assert admitted.lower[1] == pytest.approx(0.2)
     assert np.all(admitted.lower > 0.0) and np.all(admitted.lower < nominal[:-1])
+
+
+def test_the_gait_is_admitted_by_default_but_not_in_towrs_problem(flat: TerrainModel) -> None:
+    # On by default (melon_config, the pallet walks); TOWR's problem keeps
+    # TOWR's bounds, and so its fitted start (its 3.5 s walk has phases under 0.2 s).
+    assert melon_config().phase_bounds_admit_gait
+    assert not towr_config().phase_bounds_admit_gait
+    gait = make_gait("walk", 16, 5.5)
+    default = Formulation(melon_config(optimize_durations=True), TOWR_ANYMAL, gait, flat)
+    assert [list(d) for d in default.schedule.durations] == [list(d) for d in gait.durations]
+    towr = _formulation(flat, 5.5, True)
+    assert [list(d) for d in towr.schedule.durations] != [list(d) for d in gait.durations]
+    assert max(float(d.upper.max()) for d in towr.durations) == pytest.approx(1.0)
+
+
+def test_admitting_the_gait_changes_nothing_with_fixed_durations(flat: TerrainModel) -> None:
+    # The option only widens optimised phases' bounds: with fixed durations
+    # the NLP is the same, variable by variable and row by row.
+    on = _formulation(flat, 5.5, False, phase_bounds_admit_gait=True)
+    off = _formulation(flat, 5.5, False, phase_bounds_admit_gait=False)
+    assert on.row_layout == off.row_layout
+    assert [(v.name, v.size) for v in on.variable_sets] == [
+        (v.name, v.size) for v in off.variable_sets
+    ]
+    for a, b in ((on.lbx, off.lbx), (on.ubx, off.ubx), (on.lbg, off.lbg), (on.ubg, off.ubg)):
+        np.testing.assert_array_equal(a, b)
+    task = resolve(Task((0.0, 0.0, 0.0), (1.0, 0.1, 0.2)), TOWR_ANYMAL, flat)
+    x = HeuristicInitializer().guess(on, task)
+    np.testing.assert_array_equal(x, HeuristicInitializer().guess(off, task))
+    f_on, g_on, _ = on.evaluator(x, task.vector())
+    f_off, g_off, _ = off.evaluator(x, task.vector())
+    assert float(f_on) == float(f_off)
+    np.testing.assert_array_equal(np.asarray(g_on), np.asarray(g_off))

@@ -9,10 +9,12 @@ initialiser puts the model's prediction where the optimised layout expects
 it and sets the phase durations to the gait's own, the values the fixed
 NLP held them at, so that every spline of the guess is the one the model
 predicted (the same nodes at the same times): a fixed-duration solution so
-mapped meets the optimised NLP's rows as it met the fixed one's. Where a
-gait phase lies outside the optimised durations' bounds (TOWR's 0.2–1.0 s;
-the front-right foot's first stance of the 16-step walk in 5.5 s lasts
-1.079 s) it cannot be held; :func:`gait_durations` clamps it and lets the
+mapped meets the optimised NLP's rows as it met the fixed one's. The
+optimised durations' bounds admit every gait phase by default
+(``TrajoptConfig.phase_bounds_admit_gait``). Where a gait phase lies outside
+bounds that do not (TOWR's 0.2–1.0 s as :func:`~roughwalk.trajopt.towr_config`
+keeps them; the front-right foot's first stance of the 16-step walk in 5.5 s
+lasts 1.079 s) it cannot be held; :func:`gait_durations` clamps it and lets the
 next phase absorb the difference, and the guess violates the dynamics
 where that foot's force moved (the single pallet's converged fixed solve
 of held-out task 0, mapped: largest row violation 125 against 250 at the

@@ -526,18 +526,28 @@ class TrajoptConfig:
         0.01 s keeps IPOPT's bound push from moving a phase that would sit
         on its bound). The 16-step walk in 5.5 s
         and the double pallet's 20 steps in 6.875 s give the front-right
-        foot a first stance of 1.079 / 1.098 s, beyond TOWR's 1.0 s: by
-        default the NLP starts from a schedule fitted into the bounds (and
+        foot a first stance of 1.079 / 1.098 s, beyond TOWR's 1.0 s: without
+        this option the NLP starts from a schedule fitted into the bounds (and
         ``learned_fixed_durations`` clamps that stance), so a
         fixed-duration guess no longer holds its nodes at their times;
         here the gait itself is a feasible schedule and no other phase's
         bound moves (unlike a wider ``phase_duration_bounds``); at 0
-        iterations the plan is then the fixed-duration one to 1e-12. Off by
-        default: from ``learned_fixed_durations`` on the double pallet's
-        held-out seeds 0–3 it tracks 117/120 at 0 iterations (115 without)
-        and 117/120 at 5 (117 without: seed 3 task 24 gained, seed 0 task
-        26 lost); single pallet seeds 0–1 60/60 at 5 (session 20), seeds
-        0–2 90/90 at 0 and seed 2 30/30 at 5 (session 21): 90/90 at both.
+        iterations the plan is then the fixed-duration one to 1e-12. On by
+        default since session 26, with the double pallet's torque-feasible
+        model (its corner-grown retraining): from ``learned_fixed_durations``
+        on held-out seeds 0–3 it tracks 120/120 at 0 iterations and 118/120
+        at 5 (off: 115/120 at 5 with that model; the former model 117/120
+        either way), single pallet seeds 0–2 90/90 at 0 and at 5 (sessions
+        20–21); Melon's single pallet 1.0 m before with optimised durations
+        (``bench_trajopt.py``) solves in 112 iterations to cost 1.125 (off:
+        101, 1.143); the single pallet's optimised-duration model
+        (trained under TOWR's bounds) tracks 5/30 and 10/30 on seed 0 at 0
+        and 5 iterations (off: 6/30, 10/30). It changes nothing with fixed
+        durations. Off in
+        :func:`towr_config` (TOWR's own bounds): the 16-step walk in 3.5 s
+        has phases of 0.157 and 0.199 s, whose lowered bounds took TOWR's
+        block 1.5 m with optimised durations from 49 to 635 iterations (2.5 →
+        30.6 s CPU) and the stairs 1.0 m from 40 to 231 (both still solved).
     body_model:
         "robot" (single rigid body from the Robot's model) or "towr_anymal"
         (TOWR's published ANYmal values).
@@ -629,7 +639,7 @@ class TrajoptConfig:
     duration: float = 5.5
     optimize_durations: bool = False
     phase_duration_bounds: tuple[float, float] = (0.2, 1.0)
-    phase_bounds_admit_gait: bool = False
+    phase_bounds_admit_gait: bool = True
     body_model: str = "robot"
     base_poly_duration: float = 0.1
     foot_polys_per_swing: int = 2
@@ -805,6 +815,7 @@ def towr_config(**changes: object) -> TrajoptConfig:
         constraints=TOWR_CONSTRAINTS,
         costs=CostWeights.none(),
         body_model="towr_anymal",
+        phase_bounds_admit_gait=False,
         solver=SolverOptions(
             tol=1e-8,
             acceptable_tol=1e-6,
