@@ -391,7 +391,12 @@ ARCH_M = 0.015
 def _arched_way(
     start: NDArray[np.float64], goal: NDArray[np.float64], k: int
 ) -> NDArray[np.float64]:
-    """``k`` points (k, 3) from ``start`` to ``goal``, straight with the recovery's arch."""
+    """``k`` points (k, 3) from ``start`` to ``goal``, a lowered foot's way.
+
+    Straight, arched by :data:`ARCH_M` where it moves across: part 1 of
+    :func:`recovery_segment` moves the foot so, and :func:`nearer_catch`
+    checks that way against the ground.
+    """
     s = np.linspace(0.0, 1.0, k)
     way = (1.0 - s)[:, None] * start[None] + s[:, None] * goal[None]
     if np.linalg.norm(goal[:2] - start[:2]) > 0.02:
@@ -530,11 +535,7 @@ def recovery_segment(
     # Part 1, fast: the lifted feet down (with a 1.5 cm arch if they move
     # across), trunk still; the robot may be tipping towards them.
     k = 9
-    s = np.linspace(0.0, 1.0, k)
-    feet = (1.0 - s)[:, None, None] * start_feet[None] + s[:, None, None] * target[None]
-    arch = ARCH_M * np.sin(np.pi * s)
-    moving = np.linalg.norm(target[:, :2] - start_feet[:, :2], axis=1) > 0.02
-    feet[:, moving, 2] += arch[:, None]
+    feet = np.stack([_arched_way(start_feet[j], target[j], k) for j in range(4)], axis=1)
     support = np.asarray(in_contact if bearing is None else bearing, dtype=bool)
     segments = []
     if not np.all(in_contact):
